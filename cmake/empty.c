@@ -1,0 +1,1 @@
+/* Translation unit of the image target itself; everything else comes from libraries. */
