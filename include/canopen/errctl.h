@@ -1,0 +1,125 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/**
+ * @file
+ * @brief NMT error control (CiA 301 §7.2.8.3.2): heartbeat producer (1017h) and consumer
+ *        (1016h), node guarding answers and life guarding (100Ch, 100Dh).
+ *
+ * @defgroup co_errctl Error control
+ * @ingroup canopen
+ * @{
+ */
+
+#ifndef SAFELINE_INCLUDE_CANOPEN_ERRCTL_H_
+#define SAFELINE_INCLUDE_CANOPEN_ERRCTL_H_
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <canopen/line.h>
+#include <canopen/nmt.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct co_node;
+
+/** What the heartbeat consumer saw of a remote node. */
+enum co_hb_event {
+	/** A boot-up message (state 00h) arrived: the node (re)started. */
+	CO_HB_EV_BOOTUP,
+	/** The first heartbeat arrived; monitoring runs from now on. */
+	CO_HB_EV_STARTED,
+	/** No heartbeat within the consumer time (heartbeat event; EMCY 8130h). */
+	CO_HB_EV_LOST,
+	/** A heartbeat arrived again after CO_HB_EV_LOST. */
+	CO_HB_EV_RECOVERED,
+	/** The state in the heartbeat changed. */
+	CO_HB_EV_STATE,
+};
+
+/**
+ * @brief Heartbeat consumer indication.
+ *
+ * Runs in the line thread with the node's mutex held; must not block.
+ *
+ * @param node The consuming node.
+ * @param remote_id Node-ID of the producer (1..127).
+ * @param event What happened.
+ * @param state The producer's last state (CO_NMT_INITIALISING for a boot-up).
+ * @param user_data As registered.
+ */
+typedef void (*co_hb_ind_t)(struct co_node *node, uint8_t remote_id, enum co_hb_event event,
+			    enum co_nmt_state state, void *user_data);
+
+/**
+ * @brief Life guarding indication (the node's master stopped guarding it, or resumed).
+ *
+ * @param node The guarded node.
+ * @param lost true: no guarding request within the node life time (100Ch × 100Dh; EMCY
+ *        8130h); false: a request arrived again.
+ * @param user_data As registered.
+ *
+ * Runs in the line thread with the node's mutex held; must not block.
+ */
+typedef void (*co_life_ind_t)(struct co_node *node, bool lost, void *user_data);
+
+/** @cond INTERNAL_HIDDEN */
+struct co_hb_entry {
+	struct co_rx rx;
+	struct co_timer timer;
+	struct co_node *node;
+	uint16_t time_ms;
+	uint8_t remote_id;
+	uint8_t state;
+	/* 0 unused/idle (waiting for a first heartbeat), 1 active, 2 lost */
+	uint8_t mon;
+};
+
+struct co_errctl {
+	/* Heartbeat producer. */
+	struct co_timer hb_timer;
+	uint16_t hb_period_ms;
+	/* Heartbeat consumer: one entry per 1016h sub-index we serve. */
+	struct co_hb_entry hbc[CONFIG_CANOPEN_HB_CONSUMERS];
+	co_hb_ind_t hb_ind;
+	void *hb_user_data;
+	/* Node guarding answers and life guarding. */
+	struct co_rx guard_rx;
+	struct co_timer life_timer;
+	uint16_t guard_time_ms;
+	uint8_t life_factor;
+	uint8_t toggle;
+	bool guarded;
+	bool life_lost;
+	co_life_ind_t life_ind;
+	void *life_user_data;
+};
+/** @endcond */
+
+/** @brief Set the heartbeat consumer indication (NULL removes it). */
+void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data);
+
+/** @brief Set the life guarding indication (NULL removes it). */
+void co_life_set_ind(struct co_node *node, co_life_ind_t cb, void *user_data);
+
+/**
+ * @brief Last known state of a remote node monitored through 1016h.
+ *
+ * @retval 0 @p state filled.
+ * @retval -ENOENT @p remote_id is not monitored.
+ * @retval -EAGAIN No heartbeat seen yet.
+ */
+int co_hb_get_remote_state(struct co_node *node, uint8_t remote_id, enum co_nmt_state *state);
+
+#ifdef __cplusplus
+}
+#endif
+
+/** @} */
+
+#endif /* SAFELINE_INCLUDE_CANOPEN_ERRCTL_H_ */

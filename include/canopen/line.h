@@ -1,0 +1,400 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/**
+ * @file
+ * @brief CANopen line: one CAN interface, one thread, one receive table, one deadline list.
+ *
+ * A line is the unit of concurrency of the stack (DESIGN.md §3). Services register receivers
+ * (by COB-ID) and timers (by absolute deadline) on the line. The line dispatches each received
+ * frame to its receivers and each expired timer to its handler, taking the owner's mutex (the
+ * node's) around every call. The thread sleeps until the next frame or the next deadline; it
+ * never polls.
+ *
+ * The dispatch core is I/O-free: co_line_rx() and co_line_process() take the time as an
+ * argument and co_line_send() hands frames to a sink in simulation mode, so protocol tests run
+ * on simulated time without threads. co_line_start() binds the same core to a CAN device and a
+ * thread.
+ *
+ * Time is a 64-bit monotonic count of microseconds.
+ *
+ * @defgroup co_line CANopen line
+ * @ingroup canopen
+ * @{
+ */
+
+#ifndef SAFELINE_INCLUDE_CANOPEN_LINE_H_
+#define SAFELINE_INCLUDE_CANOPEN_LINE_H_
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/drivers/can.h>
+#include <zephyr/sys/slist.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct co_line;
+struct co_rx;
+struct co_timer;
+
+/** Number of 11-bit CAN identifiers, the size of the direct receive index. */
+#define CO_LINE_SFF_IDS 2048U
+
+/**
+ * @brief Receive a frame.
+ *
+ * Runs in the line thread (or the caller of co_line_rx() in simulation), with the receiver's
+ * lock held. Must not block.
+ *
+ * @param rx The receiver the frame matched.
+ * @param frame The frame; valid during the call only.
+ * @param now_us Reception time of the frame [µs].
+ */
+typedef void (*co_rx_handler_t)(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us);
+
+/**
+ * @brief Handle an expired deadline.
+ *
+ * Runs in the line thread with the timer's lock held; the timer is disarmed before the call
+ * and may be re-armed from the handler. Must not block.
+ *
+ * @param timer The timer.
+ * @param now_us Current time [µs] (at or after the deadline).
+ */
+typedef void (*co_timer_handler_t)(struct co_timer *timer, uint64_t now_us);
+
+/**
+ * @brief Send a frame in simulation mode (no CAN device).
+ *
+ * @retval 0 The frame was taken.
+ * @retval -EAGAIN The sink is full; the line queues the frame and retries on co_line_process().
+ */
+typedef int (*co_line_sink_t)(struct co_line *line, const struct can_frame *frame, void *user_data);
+
+/** Line events reported through co_line_event_cb_t. */
+enum co_line_event {
+	/** The RX queue overflowed; frames were lost (CiA 301 EMCY 8110h "CAN overrun"). */
+	CO_LINE_EV_RX_OVERRUN,
+	/** The TX queue overflowed; a frame was dropped (counted in co_line_stats). */
+	CO_LINE_EV_TX_OVERFLOW,
+	/** The CAN controller changed state; @p arg is the new enum can_state. */
+	CO_LINE_EV_CAN_STATE,
+	/** A send failed with a driver error other than back-pressure; @p arg is -errno. */
+	CO_LINE_EV_TX_ERROR,
+};
+
+/**
+ * @brief Learn about line events (overruns, controller state changes, TX errors).
+ *
+ * Runs in the line thread without any node lock held. Must not block.
+ */
+typedef void (*co_line_event_cb_t)(struct co_line *line, enum co_line_event event, int arg,
+				   void *user_data);
+
+/** A receiver: a COB-ID (optionally masked) bound to a handler. Embedded in a service. */
+struct co_rx {
+	/** CAN identifier to match (11 or 29 bits). */
+	uint32_t id;
+	/** Bits of @ref id that must match; all ones for an exact match. */
+	uint32_t mask;
+	/** Match 29-bit (extended) identifiers. */
+	bool ext;
+	/** Handler; called with @ref lock held. */
+	co_rx_handler_t handler;
+	/** Owner's mutex (a node's), or NULL. */
+	struct k_mutex *lock;
+	/** Opaque pointer for the handler. */
+	void *user_data;
+
+	/** @cond INTERNAL_HIDDEN */
+	struct co_rx *next;
+	struct co_line *line;
+	/** @endcond */
+};
+
+/** A deadline bound to a handler. Embedded in a service. */
+struct co_timer {
+	/** Handler; called with @ref lock held. */
+	co_timer_handler_t handler;
+	/** Owner's mutex (a node's), or NULL. */
+	struct k_mutex *lock;
+	/** Opaque pointer for the handler. */
+	void *user_data;
+
+	/** @cond INTERNAL_HIDDEN */
+	sys_snode_t node;
+	uint64_t deadline;
+	struct co_line *line;
+	uint32_t gen;
+	bool armed;
+	/** @endcond */
+};
+
+/** Counters of a line, for diagnostics and tests. */
+struct co_line_stats {
+	uint32_t rx_frames;    /**< Frames dispatched. */
+	uint32_t rx_unhandled; /**< Frames no receiver wanted. */
+	uint32_t rx_overruns;  /**< Frames lost because the RX queue was full. */
+	uint32_t tx_frames;    /**< Frames handed to the driver or the sink. */
+	uint32_t tx_queued;    /**< Frames that had to wait for back-pressure to clear. */
+	uint32_t tx_dropped;   /**< Frames dropped because the TX queue was full. */
+	uint32_t tx_errors;    /**< Sends refused by the driver with an error. */
+	uint16_t tx_queue_max; /**< Highest TX queue occupancy seen. */
+};
+
+/** @cond INTERNAL_HIDDEN */
+enum co_line_msg_kind {
+	CO_LINE_MSG_FRAME,
+	CO_LINE_MSG_WAKE,
+};
+
+struct co_line_rx_msg {
+	struct can_frame frame;
+	uint64_t time_us;
+	uint8_t kind;
+};
+
+struct co_line {
+	const char *name;
+	/* Receive table: sff[id] is 1 + slot of the first receiver of 11-bit id, 0 for none. */
+	uint8_t sff[CO_LINE_SFF_IDS];
+	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
+	/* 29-bit and masked receivers, searched in order. */
+	struct co_rx *others;
+	/* Armed timers sorted by deadline. */
+	sys_slist_t timers;
+	/* Protects the receive table and the timer list. Leaf lock: never held while a node
+	 * lock is taken.
+	 */
+	struct k_mutex lock;
+
+	/* TX ring; frames wait here while the driver pushes back. */
+	struct k_mutex tx_lock;
+	struct can_frame txq[CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE];
+	uint16_t tx_head;
+	uint16_t tx_count;
+	uint16_t tx_inflight;
+
+	co_line_sink_t sink;
+	void *sink_user_data;
+	co_line_event_cb_t event_cb;
+	void *event_user_data;
+	struct co_line_stats stats;
+	/* Simulation mode: the time of the last co_line_rx()/co_line_process(). */
+	uint64_t sim_now;
+
+	/* Threaded mode. */
+	const struct device *dev;
+	struct k_msgq rxq;
+	char rxq_buf[CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE * sizeof(struct co_line_rx_msg)];
+	struct k_thread thread;
+	k_tid_t tid;
+	int filter_std;
+	int filter_ext;
+	atomic_t flags;
+	atomic_t can_state;
+	atomic_t tx_async_err;
+	atomic_t rx_overruns;
+};
+/** @endcond */
+
+/**
+ * @name Setting up a line
+ * @{
+ */
+
+/**
+ * @brief Initialise a line in simulation mode: frames sent go to @p sink.
+ *
+ * Nothing runs by itself: the caller feeds frames with co_line_rx() and time with
+ * co_line_process(). Used by protocol unit tests on simulated time.
+ *
+ * @param line Line to initialise (statically allocated by the caller).
+ * @param name Name for logs; must outlive the line.
+ * @param sink Receives every frame the line sends.
+ * @param user_data Passed to @p sink.
+ */
+void co_line_init_sim(struct co_line *line, const char *name, co_line_sink_t sink, void *user_data);
+
+/**
+ * @brief Initialise a line bound to a CAN device.
+ *
+ * Receivers and timers may be registered before co_line_start().
+ *
+ * @param line Line to initialise (statically allocated by the caller).
+ * @param name Name for logs and the thread; must outlive the line.
+ * @param dev CAN controller; must be ready.
+ *
+ * @retval 0 Initialised.
+ * @retval -ENODEV The device is not ready.
+ */
+int co_line_init(struct co_line *line, const char *name, const struct device *dev);
+
+/**
+ * @brief Start the line: install the CAN filters, start the controller and the line thread.
+ *
+ * @param line Initialised line.
+ * @param stack Stack for the line thread (K_THREAD_STACK_DEFINE), owned by the line until
+ *              co_line_stop() returns.
+ * @param stack_size Size of @p stack (K_THREAD_STACK_SIZEOF).
+ * @param prio Thread priority.
+ *
+ * @retval 0 Running.
+ * @retval -EALREADY The line is already running.
+ * @retval -ENOSPC The driver has no free filter.
+ * @retval -EIO The controller could not be started.
+ */
+int co_line_start(struct co_line *line, k_thread_stack_t *stack, size_t stack_size, int prio);
+
+/**
+ * @brief Stop the line thread and remove the CAN filters. Waits for the thread to end.
+ *
+ * Must not be called from the line thread.
+ *
+ * @retval 0 Stopped.
+ * @retval -EALREADY The line was not running.
+ */
+int co_line_stop(struct co_line *line);
+
+/** @brief Set the callback for line events (NULL to remove). */
+void co_line_set_event_cb(struct co_line *line, co_line_event_cb_t cb, void *user_data);
+
+/** @} */
+
+/**
+ * @name Receivers and timers
+ * @{
+ */
+
+/**
+ * @brief Register a receiver on a line.
+ *
+ * Fill @p rx (id, mask, ext, handler, lock, user_data) first. Several receivers may share one
+ * COB-ID; each gets every matching frame. An exact 11-bit receiver (mask 7FFh) is found in
+ * constant time; masked and 29-bit receivers are searched in a short list.
+ *
+ * @retval 0 Registered.
+ * @retval -EALREADY @p rx is already registered on a line.
+ * @retval -EINVAL The id does not fit 11 (or 29) bits.
+ * @retval -ENOSPC All CONFIG_CANOPEN_LINE_RX_SLOTS distinct 11-bit ids are in use.
+ */
+int co_rx_register(struct co_line *line, struct co_rx *rx);
+
+/**
+ * @brief Remove a receiver. Safe on a receiver that is not registered.
+ */
+void co_rx_unregister(struct co_rx *rx);
+
+/**
+ * @brief Move a registered receiver to a new COB-ID (e.g. after a COB-ID object write).
+ *
+ * @retval 0 Moved (or registered, if it was not).
+ * @retval -EINVAL The id does not fit.
+ * @retval -ENOSPC No slot for the new id; the receiver is then unregistered.
+ */
+int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id);
+
+/**
+ * @brief Initialise a timer. Call once before co_timer_start().
+ */
+void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_mutex *lock,
+		   void *user_data);
+
+/**
+ * @brief Arm a timer for an absolute deadline, replacing any earlier deadline.
+ *
+ * May be called from any thread; the line thread wakes if the new deadline comes first.
+ *
+ * @param line Line whose thread runs the handler.
+ * @param timer Initialised timer.
+ * @param deadline_us Absolute time [µs] (same clock as co_line_now()).
+ */
+void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us);
+
+/** @brief Disarm a timer. Safe on a timer that is not armed. */
+void co_timer_stop(struct co_timer *timer);
+
+/** @brief Whether a timer is armed. */
+bool co_timer_is_armed(const struct co_timer *timer);
+
+/** @} */
+
+/**
+ * @name Sending and dispatch
+ * @{
+ */
+
+/**
+ * @brief Send a frame on the line, in order with every frame sent before.
+ *
+ * When the driver reports back-pressure the frame waits in the line's TX queue and goes out as
+ * soon as the driver takes frames again; the caller never retries.
+ *
+ * @retval 0 Sent or queued.
+ * @retval -ENOBUFS The TX queue is full; the frame is dropped, counted and reported
+ *         (CO_LINE_EV_TX_OVERFLOW).
+ * @retval -ENETDOWN The controller is stopped or bus-off.
+ * @retval -EIO Another driver error (reported as CO_LINE_EV_TX_ERROR).
+ */
+int co_line_send(struct co_line *line, const struct can_frame *frame);
+
+/**
+ * @brief Dispatch one received frame to its receivers.
+ *
+ * The line thread calls this for each frame; simulation tests call it directly.
+ *
+ * @param line Line.
+ * @param frame Received frame.
+ * @param now_us Reception time [µs].
+ * @return Number of receivers that got the frame.
+ */
+int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us);
+
+/**
+ * @brief Run every timer whose deadline is at or before @p now_us, and retry queued frames.
+ *
+ * @return The earliest remaining deadline [µs], or UINT64_MAX if no timer is armed.
+ */
+uint64_t co_line_process(struct co_line *line, uint64_t now_us);
+
+/** @brief Earliest armed deadline [µs], or UINT64_MAX. */
+uint64_t co_line_next_deadline(struct co_line *line);
+
+/** @brief Copy the line's counters. */
+void co_line_get_stats(struct co_line *line, struct co_line_stats *stats);
+
+/** @brief Current time of the line clock [µs] (monotonic, from k_uptime_ticks()). */
+uint64_t co_line_now(void);
+
+/**
+ * @brief Time as the line sees it [µs]: the clock for a threaded line, the time last passed to
+ * co_line_rx()/co_line_process() for a simulation line.
+ *
+ * Services use it where no time is handed to them (OD hooks, application requests), so that
+ * simulation tests stay deterministic.
+ */
+uint64_t co_line_time(const struct co_line *line);
+
+/** @} */
+
+/**
+ * @brief Whether two times are ordered a <= b, wrap-safe for any difference below 2^63 µs.
+ */
+static inline bool co_time_before_eq(uint64_t a, uint64_t b)
+{
+	return (int64_t)(a - b) <= 0;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+/** @} */
+
+#endif /* SAFELINE_INCLUDE_CANOPEN_LINE_H_ */

@@ -1,0 +1,564 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * The I/O-free core of a line: receive table, timers, TX queue. The threaded binding is in
+ * line_thread.c; everything here also runs on simulated time from a unit test.
+ *
+ * Locking: line->lock protects the receive table and the timer list and is a leaf lock. A
+ * handler is looked up under line->lock, which is released before the owner's lock is taken,
+ * so a node lock is never acquired while line->lock is held (no lock-order inversion with an
+ * application thread that holds its node lock and arms a timer).
+ */
+
+#include <errno.h>
+#include <string.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/line.h>
+
+#include "line_internal.h"
+
+LOG_MODULE_REGISTER(co_line, CONFIG_CANOPEN_LOG_LEVEL);
+
+#define SFF_MASK 0x7ffU
+#define EFF_MASK 0x1fffffffU
+
+uint64_t co_line_now(void)
+{
+	return k_ticks_to_us_floor64((uint64_t)k_uptime_ticks());
+}
+
+uint64_t co_line_time(const struct co_line *line)
+{
+	return line->dev == NULL ? line->sim_now : co_line_now();
+}
+
+static void line_init_common(struct co_line *line, const char *name)
+{
+	memset(line, 0, sizeof(*line));
+	line->name = name;
+	sys_slist_init(&line->timers);
+	k_mutex_init(&line->lock);
+	k_mutex_init(&line->tx_lock);
+}
+
+void co_line_init_sim(struct co_line *line, const char *name, co_line_sink_t sink, void *user_data)
+{
+	line_init_common(line, name);
+	line->sink = sink;
+	line->sink_user_data = user_data;
+}
+
+int co_line_init(struct co_line *line, const char *name, const struct device *dev)
+{
+	if (!device_is_ready(dev)) {
+		return -ENODEV;
+	}
+	line_init_common(line, name);
+	line->dev = dev;
+	k_msgq_init(&line->rxq, line->rxq_buf, sizeof(struct co_line_rx_msg),
+		    CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE);
+	line->filter_std = -1;
+	line->filter_ext = -1;
+	return 0;
+}
+
+void co_line_set_event_cb(struct co_line *line, co_line_event_cb_t cb, void *user_data)
+{
+	k_mutex_lock(&line->lock, K_FOREVER);
+	line->event_cb = cb;
+	line->event_user_data = user_data;
+	k_mutex_unlock(&line->lock);
+}
+
+void co_line_report(struct co_line *line, enum co_line_event event, int arg)
+{
+	co_line_event_cb_t cb = line->event_cb;
+
+	if (cb != NULL) {
+		cb(line, event, arg, line->event_user_data);
+	}
+}
+
+/* --- Receive table --------------------------------------------------------------------- */
+
+static bool rx_is_direct(const struct co_rx *rx)
+{
+	return !rx->ext && (rx->mask & SFF_MASK) == SFF_MASK;
+}
+
+static int slot_find_free(struct co_line *line)
+{
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
+		if (line->slots[i] == NULL) {
+			return i;
+		}
+	}
+	return -1;
+}
+
+static int rx_link(struct co_line *line, struct co_rx *rx)
+{
+	if (rx_is_direct(rx)) {
+		uint32_t id = rx->id & SFF_MASK;
+		uint8_t slot = line->sff[id];
+
+		if (slot == 0U) {
+			int free = slot_find_free(line);
+
+			if (free < 0) {
+				return -ENOSPC;
+			}
+			line->sff[id] = (uint8_t)(free + 1);
+			line->slots[free] = rx;
+			rx->next = NULL;
+		} else {
+			/* Append, so receivers of one id see frames in registration order. */
+			struct co_rx *tail = line->slots[slot - 1U];
+
+			while (tail->next != NULL) {
+				tail = tail->next;
+			}
+			tail->next = rx;
+			rx->next = NULL;
+		}
+	} else {
+		struct co_rx **pp = &line->others;
+
+		while (*pp != NULL) {
+			pp = &(*pp)->next;
+		}
+		*pp = rx;
+		rx->next = NULL;
+	}
+	rx->line = line;
+	return 0;
+}
+
+static void rx_unlink(struct co_line *line, struct co_rx *rx)
+{
+	struct co_rx **pp;
+
+	if (rx_is_direct(rx)) {
+		uint32_t id = rx->id & SFF_MASK;
+		uint8_t slot = line->sff[id];
+
+		if (slot == 0U) {
+			return;
+		}
+		pp = &line->slots[slot - 1U];
+		while (*pp != NULL && *pp != rx) {
+			pp = &(*pp)->next;
+		}
+		if (*pp == rx) {
+			*pp = rx->next;
+		}
+		if (line->slots[slot - 1U] == NULL) {
+			line->sff[id] = 0U;
+		}
+	} else {
+		pp = &line->others;
+		while (*pp != NULL && *pp != rx) {
+			pp = &(*pp)->next;
+		}
+		if (*pp == rx) {
+			*pp = rx->next;
+		}
+	}
+	rx->next = NULL;
+	rx->line = NULL;
+}
+
+static bool id_fits(const struct co_rx *rx, uint32_t id)
+{
+	return (id & ~(rx->ext ? EFF_MASK : SFF_MASK)) == 0U;
+}
+
+int co_rx_register(struct co_line *line, struct co_rx *rx)
+{
+	int err;
+
+	if (!id_fits(rx, rx->id)) {
+		return -EINVAL;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	if (rx->line != NULL) {
+		err = -EALREADY;
+	} else {
+		err = rx_link(line, rx);
+	}
+	k_mutex_unlock(&line->lock);
+	return err;
+}
+
+void co_rx_unregister(struct co_rx *rx)
+{
+	struct co_line *line = rx->line;
+
+	if (line == NULL) {
+		return;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	if (rx->line == line) {
+		rx_unlink(line, rx);
+	}
+	k_mutex_unlock(&line->lock);
+}
+
+int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id)
+{
+	int err;
+
+	if (!id_fits(rx, id)) {
+		return -EINVAL;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	if (rx->line != NULL) {
+		rx_unlink(rx->line, rx);
+	}
+	rx->id = id;
+	err = rx_link(line, rx);
+	k_mutex_unlock(&line->lock);
+	return err;
+}
+
+static bool rx_matches(const struct co_rx *rx, const struct can_frame *frame, bool ext)
+{
+	return rx->ext == ext && ((frame->id ^ rx->id) & rx->mask) == 0U;
+}
+
+/*
+ * Call one receiver. The receiver is re-checked under its owner's lock: the owner may have
+ * unregistered it between the lookup and now (receivers are static, so the memory is valid).
+ */
+static void rx_call(struct co_line *line, struct co_rx *rx, const struct can_frame *frame,
+		    uint64_t now_us)
+{
+	bool still_registered;
+
+	if (rx->lock != NULL) {
+		k_mutex_lock(rx->lock, K_FOREVER);
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	still_registered = (rx->line == line);
+	k_mutex_unlock(&line->lock);
+	if (still_registered) {
+		rx->handler(rx, frame, now_us);
+	}
+	if (rx->lock != NULL) {
+		k_mutex_unlock(rx->lock);
+	}
+}
+
+int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
+{
+	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
+	struct co_rx *batch[CONFIG_CANOPEN_LINE_RX_FANOUT];
+	int n = 0;
+
+	/* Collect the receivers under the table lock, call them without it. */
+	k_mutex_lock(&line->lock, K_FOREVER);
+	if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
+		line->sim_now = now_us;
+	}
+	if (!ext) {
+		uint8_t slot = line->sff[frame->id & SFF_MASK];
+
+		if (slot != 0U) {
+			for (struct co_rx *rx = line->slots[slot - 1U];
+			     rx != NULL && n < (int)ARRAY_SIZE(batch); rx = rx->next) {
+				batch[n++] = rx;
+			}
+		}
+	}
+	for (struct co_rx *rx = line->others; rx != NULL && n < (int)ARRAY_SIZE(batch);
+	     rx = rx->next) {
+		if (rx_matches(rx, frame, ext)) {
+			batch[n++] = rx;
+		}
+	}
+	line->stats.rx_frames++;
+	if (n == 0) {
+		line->stats.rx_unhandled++;
+	}
+	k_mutex_unlock(&line->lock);
+
+	for (int i = 0; i < n; i++) {
+		rx_call(line, batch[i], frame, now_us);
+	}
+	return n;
+}
+
+/* --- Timers ----------------------------------------------------------------------------- */
+
+void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_mutex *lock,
+		   void *user_data)
+{
+	memset(timer, 0, sizeof(*timer));
+	timer->handler = handler;
+	timer->lock = lock;
+	timer->user_data = user_data;
+}
+
+static void timer_unlink(struct co_line *line, struct co_timer *timer)
+{
+	/* Any start or stop makes a timer popped earlier stale. */
+	timer->gen++;
+	if (timer->armed) {
+		sys_slist_find_and_remove(&line->timers, &timer->node);
+		timer->armed = false;
+	}
+}
+
+void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us)
+{
+	struct co_line *old = timer->line;
+	sys_snode_t *prev = NULL;
+	sys_snode_t *cur;
+	bool first;
+
+	if (old != NULL && old != line) {
+		co_timer_stop(timer);
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	timer_unlink(line, timer);
+	timer->deadline = deadline_us;
+	timer->line = line;
+	/* Sorted insert; equal deadlines keep arming order. */
+	SYS_SLIST_FOR_EACH_NODE(&line->timers, cur) {
+		struct co_timer *t = CONTAINER_OF(cur, struct co_timer, node);
+
+		if (!co_time_before_eq(t->deadline, deadline_us)) {
+			break;
+		}
+		prev = cur;
+	}
+	sys_slist_insert(&line->timers, prev, &timer->node);
+	timer->armed = true;
+	first = (prev == NULL);
+	k_mutex_unlock(&line->lock);
+
+	if (first) {
+		co_line_wake(line);
+	}
+}
+
+void co_timer_stop(struct co_timer *timer)
+{
+	struct co_line *line = timer->line;
+
+	if (line == NULL) {
+		return;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	timer_unlink(line, timer);
+	k_mutex_unlock(&line->lock);
+}
+
+bool co_timer_is_armed(const struct co_timer *timer)
+{
+	struct co_line *line = timer->line;
+	bool armed;
+
+	if (line == NULL) {
+		return false;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	armed = timer->armed;
+	k_mutex_unlock(&line->lock);
+	return armed;
+}
+
+uint64_t co_line_next_deadline(struct co_line *line)
+{
+	uint64_t next = UINT64_MAX;
+	sys_snode_t *head;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	head = sys_slist_peek_head(&line->timers);
+	if (head != NULL) {
+		next = CONTAINER_OF(head, struct co_timer, node)->deadline;
+	}
+	k_mutex_unlock(&line->lock);
+	return next;
+}
+
+/* Take the first expired timer off the list, or return NULL. */
+static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us, uint32_t *gen)
+{
+	struct co_timer *t = NULL;
+	sys_snode_t *head;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	head = sys_slist_peek_head(&line->timers);
+	if (head != NULL) {
+		struct co_timer *first = CONTAINER_OF(head, struct co_timer, node);
+
+		if (co_time_before_eq(first->deadline, now_us)) {
+			sys_slist_get_not_empty(&line->timers);
+			first->armed = false;
+			*gen = first->gen;
+			t = first;
+		}
+	}
+	k_mutex_unlock(&line->lock);
+	return t;
+}
+
+uint64_t co_line_process(struct co_line *line, uint64_t now_us)
+{
+	struct co_timer *t;
+	uint32_t gen = 0U;
+
+	if (line->dev == NULL) {
+		k_mutex_lock(&line->lock, K_FOREVER);
+		if (co_time_before_eq(line->sim_now, now_us)) {
+			line->sim_now = now_us;
+		}
+		k_mutex_unlock(&line->lock);
+	}
+
+	/* A handler may re-arm its timer for a deadline already passed; bound the work so a
+	 * zero-period timer cannot starve the line.
+	 */
+	for (int budget = 4 * CONFIG_CANOPEN_LINE_RX_SLOTS; budget > 0; budget--) {
+		t = timer_pop_expired(line, now_us, &gen);
+		if (t == NULL) {
+			break;
+		}
+		bool due;
+
+		if (t->lock != NULL) {
+			k_mutex_lock(t->lock, K_FOREVER);
+		}
+		/* Started or stopped by another thread since it was popped: not due any more. */
+		k_mutex_lock(&line->lock, K_FOREVER);
+		due = t->gen == gen && t->line == line;
+		k_mutex_unlock(&line->lock);
+		if (due) {
+			t->handler(t, now_us);
+		}
+		if (t->lock != NULL) {
+			k_mutex_unlock(t->lock);
+		}
+	}
+	co_line_tx_drain(line);
+	return co_line_next_deadline(line);
+}
+
+/* --- Transmission ------------------------------------------------------------------------ */
+
+/* Hand one frame to the driver or the sink. Returns 0, -EAGAIN (back-pressure) or an error. */
+static int tx_submit(struct co_line *line, const struct can_frame *frame)
+{
+	int err;
+
+	if (line->dev == NULL) {
+		err = line->sink(line, frame, line->sink_user_data);
+	} else {
+		err = co_line_dev_send(line, frame);
+	}
+	if (err == -ENOBUFS || err == -ENOSPC) {
+		err = -EAGAIN;
+	}
+	return err;
+}
+
+static void txq_push(struct co_line *line, const struct can_frame *frame)
+{
+	uint16_t tail =
+		(uint16_t)((line->tx_head + line->tx_count) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+
+	line->txq[tail] = *frame;
+	line->tx_count++;
+	line->stats.tx_queued++;
+	atomic_set_bit(&line->flags, CO_LINE_F_TX_WAITING);
+	if (line->tx_count > line->stats.tx_queue_max) {
+		line->stats.tx_queue_max = line->tx_count;
+	}
+}
+
+int co_line_send(struct co_line *line, const struct can_frame *frame)
+{
+	int err = 0;
+	bool overflow = false;
+	bool error = false;
+
+	k_mutex_lock(&line->tx_lock, K_FOREVER);
+	if (line->tx_count == 0U) {
+		err = tx_submit(line, frame);
+		if (err == 0) {
+			line->stats.tx_frames++;
+		} else if (err == -EAGAIN) {
+			txq_push(line, frame);
+			err = 0;
+		} else {
+			line->stats.tx_errors++;
+			error = true;
+		}
+	} else if (line->tx_count < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE) {
+		/* Frames are waiting: queue behind them to keep the order. */
+		txq_push(line, frame);
+	} else {
+		line->stats.tx_dropped++;
+		overflow = true;
+		err = -ENOBUFS;
+	}
+	k_mutex_unlock(&line->tx_lock);
+
+	if (overflow) {
+		LOG_WRN("%s: TX queue full, frame %03x dropped", line->name, frame->id);
+		co_line_report(line, CO_LINE_EV_TX_OVERFLOW, 0);
+	} else if (error) {
+		co_line_report(line, CO_LINE_EV_TX_ERROR, err);
+	}
+	return err;
+}
+
+void co_line_tx_drain(struct co_line *line)
+{
+	int err = 0;
+
+	k_mutex_lock(&line->tx_lock, K_FOREVER);
+	while (line->tx_count > 0U) {
+		err = tx_submit(line, &line->txq[line->tx_head]);
+		if (err == -EAGAIN) {
+			err = 0;
+			break;
+		}
+		if (err == 0) {
+			line->stats.tx_frames++;
+		} else {
+			line->stats.tx_errors++;
+		}
+		line->tx_head =
+			(uint16_t)((line->tx_head + 1U) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+		line->tx_count--;
+		if (err != 0) {
+			break;
+		}
+	}
+	if (line->tx_count == 0U) {
+		atomic_clear_bit(&line->flags, CO_LINE_F_TX_WAITING);
+	}
+	k_mutex_unlock(&line->tx_lock);
+
+	if (err != 0) {
+		co_line_report(line, CO_LINE_EV_TX_ERROR, err);
+	}
+}
+
+void co_line_get_stats(struct co_line *line, struct co_line_stats *stats)
+{
+	k_mutex_lock(&line->lock, K_FOREVER);
+	k_mutex_lock(&line->tx_lock, K_FOREVER);
+	*stats = line->stats;
+	stats->rx_overruns = (uint32_t)atomic_get(&line->rx_overruns);
+	k_mutex_unlock(&line->tx_lock);
+	k_mutex_unlock(&line->lock);
+}

@@ -1,0 +1,37 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/* Between the line core (line.c) and its threaded binding (line_thread.c). */
+
+#ifndef SAFELINE_SUBSYS_CANOPEN_CORE_LINE_INTERNAL_H_
+#define SAFELINE_SUBSYS_CANOPEN_CORE_LINE_INTERNAL_H_
+
+#include <canopen/line.h>
+
+/* Flags in co_line.flags. */
+#define CO_LINE_F_RUNNING      0
+#define CO_LINE_F_STOP         1
+/* Frames wait in the TX queue: a TX completion must wake the thread to drain it. */
+#define CO_LINE_F_TX_WAITING   2
+/* The RX queue overflowed since the thread last reported it. */
+#define CO_LINE_F_RX_OVERRUN   3
+/* The controller state changed since the thread last reported it. */
+#define CO_LINE_F_STATE        4
+/* A wake message is in the RX queue. */
+#define CO_LINE_F_WAKE_PENDING 5
+
+/* Wake the line thread so it re-reads its deadline (no-op in simulation). */
+void co_line_wake(struct co_line *line);
+
+/* Send through the CAN device: 0, -EAGAIN/-ENOBUFS on back-pressure, or a driver error. */
+int co_line_dev_send(struct co_line *line, const struct can_frame *frame);
+
+/* Retry frames that wait in the TX queue. */
+void co_line_tx_drain(struct co_line *line);
+
+/* Report an event to the line's event callback. */
+void co_line_report(struct co_line *line, enum co_line_event event, int arg);
+
+#endif /* SAFELINE_SUBSYS_CANOPEN_CORE_LINE_INTERNAL_H_ */

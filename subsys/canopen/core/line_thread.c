@@ -1,0 +1,202 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * The threaded binding of a line: CAN driver callbacks feed the RX queue, the line thread
+ * sleeps in k_msgq_get() until a frame arrives or the next deadline passes.
+ *
+ * Driver callbacks (RX, TX completion, state change) may run in interrupt context on a real
+ * target: they only stamp and queue frames, set atomic flags and wake the thread.
+ */
+
+#include <errno.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/drivers/can.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/line.h>
+
+#include "line_internal.h"
+
+LOG_MODULE_DECLARE(co_line, CONFIG_CANOPEN_LOG_LEVEL);
+
+void co_line_wake(struct co_line *line)
+{
+	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
+
+	if (line->dev == NULL || !atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
+		return;
+	}
+	/* The line thread re-reads its deadline before sleeping anyway. */
+	if (k_current_get() == line->tid) {
+		return;
+	}
+	/* One wake message at a time, so wakes never crowd frames out of the queue; a full
+	 * queue wakes the thread anyway.
+	 */
+	if (!atomic_test_and_set_bit(&line->flags, CO_LINE_F_WAKE_PENDING)) {
+		if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
+			atomic_clear_bit(&line->flags, CO_LINE_F_WAKE_PENDING);
+		}
+	}
+}
+
+static void line_rx_cb(const struct device *dev, struct can_frame *frame, void *user_data)
+{
+	struct co_line *line = user_data;
+	struct co_line_rx_msg msg = {
+		.frame = *frame,
+		.time_us = co_line_now(),
+		.kind = CO_LINE_MSG_FRAME,
+	};
+
+	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
+		/* Counted here; reported by the thread, which is busy draining the queue. */
+		atomic_inc(&line->rx_overruns);
+		atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+	}
+}
+
+static void line_tx_cb(const struct device *dev, int error, void *user_data)
+{
+	struct co_line *line = user_data;
+
+	if (error != 0) {
+		atomic_set(&line->tx_async_err, error);
+	}
+	if (error != 0 || atomic_test_bit(&line->flags, CO_LINE_F_TX_WAITING)) {
+		co_line_wake(line);
+	}
+}
+
+static void line_state_cb(const struct device *dev, enum can_state state,
+			  struct can_bus_err_cnt err_cnt, void *user_data)
+{
+	struct co_line *line = user_data;
+
+	atomic_set(&line->can_state, (atomic_val_t)state);
+	atomic_set_bit(&line->flags, CO_LINE_F_STATE);
+	co_line_wake(line);
+}
+
+int co_line_dev_send(struct co_line *line, const struct can_frame *frame)
+{
+	return can_send(line->dev, frame, K_NO_WAIT, line_tx_cb, line);
+}
+
+static void line_report_async(struct co_line *line)
+{
+	atomic_val_t err;
+
+	if (atomic_test_and_clear_bit(&line->flags, CO_LINE_F_RX_OVERRUN)) {
+		LOG_WRN("%s: RX queue overrun", line->name);
+		co_line_report(line, CO_LINE_EV_RX_OVERRUN, 0);
+	}
+	if (atomic_test_and_clear_bit(&line->flags, CO_LINE_F_STATE)) {
+		co_line_report(line, CO_LINE_EV_CAN_STATE, (int)atomic_get(&line->can_state));
+	}
+	err = atomic_set(&line->tx_async_err, 0);
+	if (err != 0) {
+		co_line_report(line, CO_LINE_EV_TX_ERROR, (int)err);
+	}
+}
+
+static void line_thread(void *p1, void *p2, void *p3)
+{
+	struct co_line *line = p1;
+	struct co_line_rx_msg msg;
+
+	while (!atomic_test_bit(&line->flags, CO_LINE_F_STOP)) {
+		uint64_t next = co_line_process(line, co_line_now());
+		k_timeout_t timeout = K_FOREVER;
+
+		if (next != UINT64_MAX) {
+			timeout = K_TIMEOUT_ABS_TICKS(k_us_to_ticks_ceil64(next));
+		}
+		if (k_msgq_get(&line->rxq, &msg, timeout) == 0) {
+			/* Drain what is queued before looking at timers again, but bounded so
+			 * that a flood cannot hold deadlines off for long.
+			 */
+			int budget = CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE;
+
+			do {
+				if (msg.kind == CO_LINE_MSG_FRAME) {
+					co_line_rx(line, &msg.frame, msg.time_us);
+				} else {
+					atomic_clear_bit(&line->flags, CO_LINE_F_WAKE_PENDING);
+				}
+			} while (--budget > 0 && k_msgq_get(&line->rxq, &msg, K_NO_WAIT) == 0);
+		}
+		line_report_async(line);
+	}
+}
+
+int co_line_start(struct co_line *line, k_thread_stack_t *stack, size_t stack_size, int prio)
+{
+	const struct can_filter std = {.id = 0U, .mask = 0U, .flags = 0U};
+	const struct can_filter ext = {.id = 0U, .mask = 0U, .flags = CAN_FILTER_IDE};
+	int err;
+
+	if (line->dev == NULL) {
+		return -ENODEV;
+	}
+	if (atomic_test_and_set_bit(&line->flags, CO_LINE_F_RUNNING)) {
+		return -EALREADY;
+	}
+	atomic_clear_bit(&line->flags, CO_LINE_F_STOP);
+
+	/* Everything goes to the software table; CANopen needs most 11-bit ids anyway. */
+	line->filter_std = can_add_rx_filter(line->dev, line_rx_cb, line, &std);
+	line->filter_ext = can_add_rx_filter(line->dev, line_rx_cb, line, &ext);
+	if (line->filter_std < 0 || line->filter_ext < 0) {
+		err = -ENOSPC;
+		goto fail;
+	}
+	can_set_state_change_callback(line->dev, line_state_cb, line);
+	err = can_start(line->dev);
+	if (err != 0 && err != -EALREADY) {
+		LOG_ERR("%s: cannot start CAN controller (%d)", line->name, err);
+		err = -EIO;
+		goto fail;
+	}
+
+	line->tid = k_thread_create(&line->thread, stack, stack_size, line_thread, line, NULL, NULL,
+				    prio, 0, K_NO_WAIT);
+	k_thread_name_set(line->tid, line->name);
+	return 0;
+
+fail:
+	if (line->filter_std >= 0) {
+		can_remove_rx_filter(line->dev, line->filter_std);
+	}
+	if (line->filter_ext >= 0) {
+		can_remove_rx_filter(line->dev, line->filter_ext);
+	}
+	line->filter_std = -1;
+	line->filter_ext = -1;
+	atomic_clear_bit(&line->flags, CO_LINE_F_RUNNING);
+	return err;
+}
+
+int co_line_stop(struct co_line *line)
+{
+	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
+
+	if (!atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
+		return -EALREADY;
+	}
+	atomic_set_bit(&line->flags, CO_LINE_F_STOP);
+	(void)k_msgq_put(&line->rxq, &msg, K_NO_WAIT);
+	k_thread_join(&line->thread, K_FOREVER);
+
+	can_remove_rx_filter(line->dev, line->filter_std);
+	can_remove_rx_filter(line->dev, line->filter_ext);
+	can_set_state_change_callback(line->dev, NULL, NULL);
+	line->filter_std = -1;
+	line->filter_ext = -1;
+	atomic_clear_bit(&line->flags, CO_LINE_F_RUNNING);
+	return 0;
+}

@@ -1,0 +1,401 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * NMT error control (CiA 301 §7.2.8.3.2): heartbeat producer 1017h, heartbeat consumer 1016h,
+ * node guarding answers and life guarding 100Ch/100Dh. Writes to these objects take effect at
+ * once through OD hooks.
+ *
+ * Decisions (doc/nmt.md):
+ * - A node with a heartbeat period (1017h != 0) does not answer guarding requests: a node is
+ *   heartbeat-monitored or guarded, not both (CiA 301 §7.2.8.3.2.1).
+ * - The producer sends one heartbeat at once on every change among Pre-operational,
+ *   Operational and Stopped, so masters see the new state without waiting a period; the first
+ *   heartbeat after the boot-up message is due one period later.
+ * - A consumer starts monitoring with the first heartbeat, not the boot-up message (a boot-up
+ *   is reported, and monitoring waits for the node's first heartbeat again).
+ */
+
+#include <errno.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/errctl.h>
+#include <canopen/node.h>
+
+#include "node_internal.h"
+
+LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
+
+#define IDX_GUARD_TIME  0x100CU
+#define IDX_LIFE_FACTOR 0x100DU
+#define IDX_HB_CONSUMER 0x1016U
+#define IDX_HB_PRODUCER 0x1017U
+
+enum hb_mon {
+	HB_IDLE,
+	HB_ACTIVE,
+	HB_LOST,
+};
+
+static uint64_t now_of(struct co_node *node)
+{
+	return co_line_time(node->line);
+}
+
+static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub)
+{
+	uint8_t buf[8] = {0};
+	size_t len = 0;
+
+	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
+		return 0U;
+	}
+	return co_od_le_get(buf, len);
+}
+
+static void send_state(struct co_node *node, uint8_t toggle)
+{
+	struct can_frame f = {
+		.id = CO_NMT_EC_COB_ID + node->node_id,
+		.dlc = 1U,
+		.data = {(uint8_t)(toggle | (uint8_t)node->nmt.state)},
+	};
+
+	(void)co_node_send(node, &f);
+}
+
+/* --- Heartbeat producer ------------------------------------------------------------------- */
+
+static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_node *node = timer->user_data;
+	uint64_t period = (uint64_t)node->ec.hb_period_ms * 1000U;
+	uint64_t next = timer->deadline + period;
+
+	send_state(node, 0U);
+	/* Keep the cadence; after a long stall start afresh rather than burst. */
+	if (co_time_before_eq(next, now_us)) {
+		next = now_us + period;
+	}
+	co_timer_start(node->line, timer, next);
+}
+
+static void hb_restart(struct co_node *node, bool send_now)
+{
+	co_timer_stop(&node->ec.hb_timer);
+	if (node->ec.hb_period_ms == 0U || node->nmt.state == CO_NMT_INITIALISING) {
+		return;
+	}
+	if (send_now) {
+		send_state(node, 0U);
+	}
+	co_timer_start(node->line, &node->ec.hb_timer,
+		       now_of(node) + (uint64_t)node->ec.hb_period_ms * 1000U);
+}
+
+static void hb_producer_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	node->ec.hb_period_ms = (uint16_t)co_od_req_uint(req);
+	/* A new period takes effect at once: the next heartbeat is one new period away. */
+	hb_restart(node, false);
+}
+
+/* --- Heartbeat consumer ------------------------------------------------------------------- */
+
+static void hbc_report(struct co_hb_entry *e, enum co_hb_event ev)
+{
+	struct co_node *node = e->node;
+
+	if (node->ec.hb_ind != NULL) {
+		node->ec.hb_ind(node, e->remote_id, ev, (enum co_nmt_state)e->state,
+				node->ec.hb_user_data);
+	}
+}
+
+static void hbc_timeout(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_hb_entry *e = timer->user_data;
+
+	if (e->mon == HB_ACTIVE) {
+		e->mon = HB_LOST;
+		LOG_WRN("%s: heartbeat of node %u lost", e->node->name, e->remote_id);
+		hbc_report(e, CO_HB_EV_LOST);
+	}
+}
+
+static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_hb_entry *e = rx->user_data;
+	uint8_t state;
+	uint8_t prev = e->state;
+
+	/* Guarding requests (RTR) and answers (toggle bit set) are not heartbeats. */
+	if ((frame->flags & CAN_FRAME_RTR) != 0U || frame->dlc != 1U ||
+	    (frame->data[0] & 0x80U) != 0U) {
+		return;
+	}
+	state = frame->data[0];
+	e->state = state;
+	if (state == (uint8_t)CO_NMT_INITIALISING) {
+		co_timer_stop(&e->timer);
+		e->mon = HB_IDLE;
+		hbc_report(e, CO_HB_EV_BOOTUP);
+		return;
+	}
+	co_timer_start(e->node->line, &e->timer, now_us + (uint64_t)e->time_ms * 1000U);
+	if (e->mon == HB_IDLE) {
+		e->mon = HB_ACTIVE;
+		hbc_report(e, CO_HB_EV_STARTED);
+	} else if (e->mon == HB_LOST) {
+		e->mon = HB_ACTIVE;
+		hbc_report(e, CO_HB_EV_RECOVERED);
+	} else if (prev != state) {
+		hbc_report(e, CO_HB_EV_STATE);
+	}
+}
+
+static bool hbc_value_active(uint32_t v)
+{
+	uint8_t id = (uint8_t)(v >> 16);
+
+	return id >= 1U && id <= 127U && (v & 0xffffU) != 0U;
+}
+
+/* Apply 1016h sub (i + 1) to entry i. */
+static void hbc_configure(struct co_node *node, int i, uint32_t value)
+{
+	struct co_hb_entry *e = &node->ec.hbc[i];
+
+	co_rx_unregister(&e->rx);
+	co_timer_stop(&e->timer);
+	e->mon = HB_IDLE;
+	e->state = (uint8_t)CO_NMT_INITIALISING;
+	e->remote_id = 0U;
+	e->time_ms = 0U;
+	if (!hbc_value_active(value)) {
+		return;
+	}
+	e->remote_id = (uint8_t)(value >> 16);
+	e->time_ms = (uint16_t)value;
+	e->rx.id = CO_NMT_EC_COB_ID + e->remote_id;
+	if (co_rx_register(node->line, &e->rx) != 0) {
+		LOG_ERR("%s: no receive slot to monitor node %u", node->name, e->remote_id);
+	}
+}
+
+/* CiA 301: two active entries for one node-ID are a parameter incompatibility. */
+static uint32_t hbc_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint32_t v = (uint32_t)co_od_req_uint(req);
+	uint8_t sub = req->info->sub;
+	uint8_t count;
+
+	if (sub == 0U || !hbc_value_active(v)) {
+		return 0U;
+	}
+	count = (uint8_t)od_uint(node, IDX_HB_CONSUMER, 0);
+	for (uint8_t s = 1; s <= count; s++) {
+		uint32_t other = (uint32_t)od_uint(node, IDX_HB_CONSUMER, s);
+
+		if (s != sub && hbc_value_active(other) &&
+		    (uint8_t)(other >> 16) == (uint8_t)(v >> 16)) {
+			return CO_SDO_AB_PARAM_INCOMPAT;
+		}
+	}
+	return 0U;
+}
+
+static void hbc_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint8_t sub = req->info->sub;
+
+	if (sub >= 1U && sub <= CONFIG_CANOPEN_HB_CONSUMERS) {
+		hbc_configure(node, sub - 1, (uint32_t)co_od_req_uint(req));
+	}
+}
+
+/* --- Node guarding and life guarding ------------------------------------------------------ */
+
+static void life_timeout(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_node *node = timer->user_data;
+
+	node->ec.life_lost = true;
+	LOG_WRN("%s: life guarding event (no guarding request within %u ms)", node->name,
+		node->ec.guard_time_ms * node->ec.life_factor);
+	if (node->ec.life_ind != NULL) {
+		node->ec.life_ind(node, true, node->ec.life_user_data);
+	}
+}
+
+static void life_restart(struct co_node *node, uint64_t now_us)
+{
+	uint32_t life_ms = (uint32_t)node->ec.guard_time_ms * node->ec.life_factor;
+
+	if (!node->ec.guarded || life_ms == 0U) {
+		co_timer_stop(&node->ec.life_timer);
+		return;
+	}
+	co_timer_start(node->line, &node->ec.life_timer, now_us + (uint64_t)life_ms * 1000U);
+}
+
+static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_node *node = rx->user_data;
+
+	if ((frame->flags & CAN_FRAME_RTR) == 0U || node->ec.hb_period_ms != 0U ||
+	    node->nmt.state == CO_NMT_INITIALISING) {
+		return;
+	}
+	send_state(node, node->ec.toggle);
+	node->ec.toggle ^= 0x80U;
+	/* Life guarding starts with the first request. */
+	node->ec.guarded = true;
+	life_restart(node, now_us);
+	if (node->ec.life_lost) {
+		node->ec.life_lost = false;
+		if (node->ec.life_ind != NULL) {
+			node->ec.life_ind(node, false, node->ec.life_user_data);
+		}
+	}
+}
+
+static void guard_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	if (req->info->index == IDX_GUARD_TIME) {
+		node->ec.guard_time_ms = (uint16_t)co_od_req_uint(req);
+	} else {
+		node->ec.life_factor = (uint8_t)co_od_req_uint(req);
+	}
+	life_restart(node, now_of(node));
+}
+
+/* --- Node interface ----------------------------------------------------------------------- */
+
+int co_errctl_init(struct co_node *node)
+{
+	struct co_errctl *ec = &node->ec;
+	const struct co_od_hook hooks[] = {
+		{IDX_HB_PRODUCER, IDX_HB_PRODUCER, 0, 0, NULL, hb_producer_notify, node},
+		{IDX_HB_CONSUMER, IDX_HB_CONSUMER, 1, 255, hbc_validate, hbc_notify, node},
+		{IDX_GUARD_TIME, IDX_LIFE_FACTOR, 0, 0, NULL, guard_notify, node},
+	};
+
+	co_timer_init(&ec->hb_timer, hb_timer_handler, &node->lock, node);
+	co_timer_init(&ec->life_timer, life_timeout, &node->lock, node);
+	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
+		struct co_hb_entry *e = &ec->hbc[i];
+
+		e->node = node;
+		e->rx.mask = 0x7ffU;
+		e->rx.handler = hbc_rx;
+		e->rx.lock = &node->lock;
+		e->rx.user_data = e;
+		co_timer_init(&e->timer, hbc_timeout, &node->lock, e);
+	}
+	ec->guard_rx.mask = 0x7ffU;
+	ec->guard_rx.handler = guard_rx;
+	ec->guard_rx.lock = &node->lock;
+	ec->guard_rx.user_data = node;
+
+	for (size_t i = 0; i < ARRAY_SIZE(hooks); i++) {
+		int err = co_od_hook_register(&node->od, &hooks[i]);
+
+		if (err != 0) {
+			return err;
+		}
+	}
+	return 0;
+}
+
+void co_errctl_reset_comm(struct co_node *node)
+{
+	struct co_errctl *ec = &node->ec;
+	uint8_t count = (uint8_t)od_uint(node, IDX_HB_CONSUMER, 0);
+
+	co_timer_stop(&ec->hb_timer);
+	co_timer_stop(&ec->life_timer);
+	ec->hb_period_ms = (uint16_t)od_uint(node, IDX_HB_PRODUCER, 0);
+	ec->guard_time_ms = (uint16_t)od_uint(node, IDX_GUARD_TIME, 0);
+	ec->life_factor = (uint8_t)od_uint(node, IDX_LIFE_FACTOR, 0);
+	/* The first guarding answer after a reset has the toggle bit 0. */
+	ec->toggle = 0U;
+	ec->guarded = false;
+	ec->life_lost = false;
+
+	if (count > CONFIG_CANOPEN_HB_CONSUMERS) {
+		LOG_WRN("%s: 1016h has %u entries, CONFIG_CANOPEN_HB_CONSUMERS=%d are served",
+			node->name, count, CONFIG_CANOPEN_HB_CONSUMERS);
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
+		uint32_t v =
+			i < count ? (uint32_t)od_uint(node, IDX_HB_CONSUMER, (uint8_t)(i + 1)) : 0U;
+
+		hbc_configure(node, i, v);
+	}
+	(void)co_rx_set_id(node->line, &ec->guard_rx, CO_NMT_EC_COB_ID + node->node_id);
+}
+
+void co_errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
+{
+	struct co_errctl *ec = &node->ec;
+
+	if (to == CO_NMT_INITIALISING) {
+		co_timer_stop(&ec->hb_timer);
+		co_timer_stop(&ec->life_timer);
+		for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
+			co_timer_stop(&ec->hbc[i].timer);
+		}
+		return;
+	}
+	/* From Initialising the boot-up message was just sent. */
+	hb_restart(node, from != CO_NMT_INITIALISING);
+}
+
+void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->ec.hb_ind = cb;
+	node->ec.hb_user_data = user_data;
+	co_node_unlock(node);
+}
+
+void co_life_set_ind(struct co_node *node, co_life_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->ec.life_ind = cb;
+	node->ec.life_user_data = user_data;
+	co_node_unlock(node);
+}
+
+int co_hb_get_remote_state(struct co_node *node, uint8_t remote_id, enum co_nmt_state *state)
+{
+	int err = -ENOENT;
+
+	co_node_lock(node);
+	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
+		struct co_hb_entry *e = &node->ec.hbc[i];
+
+		if (e->remote_id == remote_id && e->time_ms != 0U) {
+			if (e->mon == HB_IDLE) {
+				err = -EAGAIN;
+			} else {
+				*state = (enum co_nmt_state)e->state;
+				err = 0;
+			}
+			break;
+		}
+	}
+	co_node_unlock(node);
+	return err;
+}

@@ -1,0 +1,364 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/* The line core driven on simulated time: no thread, no CAN device. */
+
+#include <errno.h>
+#include <string.h>
+
+#include <zephyr/ztest.h>
+
+#include <canopen/line.h>
+
+#define MAX_LOG 32
+
+struct fixture {
+	struct co_line line;
+	struct k_mutex node_lock;
+	/* What handlers saw, in order. */
+	int log[MAX_LOG];
+	uint64_t log_time[MAX_LOG];
+	int log_len;
+	/* Frames the sink accepted. */
+	struct can_frame sent[MAX_LOG];
+	int sent_len;
+	int sink_result;
+	int events[MAX_LOG];
+	int event_args[MAX_LOG];
+	int event_len;
+};
+
+static struct fixture fx;
+
+static void record(int tag, uint64_t now)
+{
+	zassert_true(fx.log_len < MAX_LOG);
+	fx.log_time[fx.log_len] = now;
+	fx.log[fx.log_len++] = tag;
+}
+
+static void rx_handler(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	record((int)(intptr_t)rx->user_data, now_us);
+}
+
+static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
+{
+	if (fx.sink_result != 0) {
+		return fx.sink_result;
+	}
+	zassert_true(fx.sent_len < MAX_LOG);
+	fx.sent[fx.sent_len++] = *frame;
+	return 0;
+}
+
+static void event_cb(struct co_line *line, enum co_line_event event, int arg, void *user_data)
+{
+	fx.events[fx.event_len] = event;
+	fx.event_args[fx.event_len++] = arg;
+}
+
+static void *setup(void)
+{
+	return &fx;
+}
+
+static void before(void *f)
+{
+	memset(&fx, 0, sizeof(fx));
+	k_mutex_init(&fx.node_lock);
+	co_line_init_sim(&fx.line, "sim0", sink, NULL);
+	co_line_set_event_cb(&fx.line, event_cb, NULL);
+}
+
+ZTEST_SUITE(co_line, NULL, setup, before, NULL, NULL);
+
+static void rx_fill(struct co_rx *rx, uint32_t id, uint32_t mask, bool ext, int tag)
+{
+	memset(rx, 0, sizeof(*rx));
+	rx->id = id;
+	rx->mask = mask;
+	rx->ext = ext;
+	rx->handler = rx_handler;
+	rx->lock = &fx.node_lock;
+	rx->user_data = (void *)(intptr_t)tag;
+}
+
+static struct can_frame std_frame(uint32_t id, uint8_t dlc)
+{
+	struct can_frame f = {.id = id, .dlc = dlc};
+
+	for (uint8_t i = 0; i < dlc; i++) {
+		f.data[i] = i;
+	}
+	return f;
+}
+
+ZTEST(co_line, test_exact_receivers_get_frames_in_registration_order)
+{
+	struct co_rx a, b, c;
+	struct can_frame f = std_frame(0x181, 2);
+
+	rx_fill(&a, 0x181, 0x7ff, false, 1);
+	rx_fill(&b, 0x181, 0x7ff, false, 2);
+	rx_fill(&c, 0x182, 0x7ff, false, 3);
+	zassert_ok(co_rx_register(&fx.line, &a));
+	zassert_ok(co_rx_register(&fx.line, &b));
+	zassert_ok(co_rx_register(&fx.line, &c));
+
+	zassert_equal(co_line_rx(&fx.line, &f, 1000), 2);
+	zassert_equal(fx.log_len, 2);
+	zassert_equal(fx.log[0], 1);
+	zassert_equal(fx.log[1], 2);
+	zassert_equal(fx.log_time[0], 1000, "handler gets the reception time");
+}
+
+ZTEST(co_line, test_unregister_stops_delivery_and_frees_the_slot)
+{
+	struct co_rx rx[CONFIG_CANOPEN_LINE_RX_SLOTS + 1];
+	struct can_frame f = std_frame(0x200, 0);
+
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
+		rx_fill(&rx[i], 0x200 + i, 0x7ff, false, i);
+		zassert_ok(co_rx_register(&fx.line, &rx[i]));
+	}
+	rx_fill(&rx[CONFIG_CANOPEN_LINE_RX_SLOTS], 0x300, 0x7ff, false, 99);
+	zassert_equal(co_rx_register(&fx.line, &rx[CONFIG_CANOPEN_LINE_RX_SLOTS]), -ENOSPC,
+		      "all slots used");
+
+	co_rx_unregister(&rx[0]);
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 0);
+	zassert_ok(co_rx_register(&fx.line, &rx[CONFIG_CANOPEN_LINE_RX_SLOTS]),
+		   "the freed slot is reused");
+	co_rx_unregister(&rx[0]); /* not registered: harmless */
+
+	struct co_line_stats st;
+
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.rx_unhandled, 1);
+}
+
+ZTEST(co_line, test_register_checks_ids_and_double_registration)
+{
+	struct co_rx a, b;
+
+	rx_fill(&a, 0x800, 0x7ff, false, 1);
+	zassert_equal(co_rx_register(&fx.line, &a), -EINVAL, "11-bit id out of range");
+	rx_fill(&b, 0x20000000, 0x1fffffff, true, 2);
+	zassert_equal(co_rx_register(&fx.line, &b), -EINVAL, "29-bit id out of range");
+	rx_fill(&a, 0x7ff, 0x7ff, false, 1);
+	zassert_ok(co_rx_register(&fx.line, &a));
+	zassert_equal(co_rx_register(&fx.line, &a), -EALREADY);
+}
+
+ZTEST(co_line, test_masked_and_extended_receivers)
+{
+	struct co_rx lss_any, ext;
+	struct can_frame f = std_frame(0x7e5, 8);
+	struct can_frame fe = std_frame(0x12345, 1);
+
+	/* All ids 0x7e0..0x7ef. */
+	rx_fill(&lss_any, 0x7e0, 0x7f0, false, 1);
+	rx_fill(&ext, 0x12345, 0x1fffffff, true, 2);
+	zassert_ok(co_rx_register(&fx.line, &lss_any));
+	zassert_ok(co_rx_register(&fx.line, &ext));
+
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 1);
+	f.id = 0x7f5;
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 0, "outside the mask");
+	zassert_equal(co_line_rx(&fx.line, &fe, 0), 0, "standard frame with an extended id value");
+	fe.flags = CAN_FRAME_IDE;
+	zassert_equal(co_line_rx(&fx.line, &fe, 0), 1);
+	fe.id = 0x345;
+	zassert_equal(co_line_rx(&fx.line, &fe, 0), 0);
+	zassert_equal(fx.log_len, 2);
+	zassert_equal(fx.log[1], 2);
+}
+
+ZTEST(co_line, test_set_id_moves_a_receiver)
+{
+	struct co_rx a;
+	struct can_frame f = std_frame(0x181, 1);
+
+	rx_fill(&a, 0x181, 0x7ff, false, 7);
+	zassert_ok(co_rx_register(&fx.line, &a));
+	zassert_ok(co_rx_set_id(&fx.line, &a, 0x281));
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 0);
+	f.id = 0x281;
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 1);
+	zassert_equal(co_rx_set_id(&fx.line, &a, 0x900), -EINVAL);
+	zassert_equal(co_line_rx(&fx.line, &f, 0), 1, "a refused move keeps the old id");
+}
+
+struct tagged_timer {
+	struct co_timer t;
+	int tag;
+	uint64_t rearm_period;
+	int fired;
+};
+
+static void timer_handler(struct co_timer *timer, uint64_t now_us)
+{
+	struct tagged_timer *tt = CONTAINER_OF(timer, struct tagged_timer, t);
+
+	tt->fired++;
+	record(tt->tag, now_us);
+	if (tt->rearm_period != 0U) {
+		co_timer_start(&fx.line, timer, timer->deadline + tt->rearm_period);
+	}
+}
+
+ZTEST(co_line, test_timers_run_in_deadline_order_and_report_the_next)
+{
+	struct tagged_timer a = {.tag = 1}, b = {.tag = 2}, c = {.tag = 3};
+
+	co_timer_init(&a.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_init(&b.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_init(&c.t, timer_handler, NULL, NULL);
+	zassert_equal(co_line_next_deadline(&fx.line), UINT64_MAX);
+
+	co_timer_start(&fx.line, &a.t, 3000);
+	co_timer_start(&fx.line, &b.t, 1000);
+	co_timer_start(&fx.line, &c.t, 1000); /* same deadline: after b */
+	zassert_equal(co_line_next_deadline(&fx.line), 1000);
+
+	zassert_equal(co_line_process(&fx.line, 999), 1000, "nothing due yet");
+	zassert_equal(fx.log_len, 0);
+	zassert_equal(co_line_process(&fx.line, 2000), 3000);
+	zassert_equal(fx.log_len, 2);
+	zassert_equal(fx.log[0], 2);
+	zassert_equal(fx.log[1], 3);
+	zassert_false(co_timer_is_armed(&b.t));
+	zassert_true(co_timer_is_armed(&a.t));
+	zassert_equal(co_line_process(&fx.line, 5000), UINT64_MAX);
+	zassert_equal(fx.log[2], 1);
+	zassert_equal(fx.log_time[2], 5000, "handler gets the current time");
+}
+
+ZTEST(co_line, test_restart_replaces_the_deadline_and_stop_disarms)
+{
+	struct tagged_timer a = {.tag = 1};
+
+	co_timer_init(&a.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_start(&fx.line, &a.t, 1000);
+	co_timer_start(&fx.line, &a.t, 4000);
+	zassert_equal(co_line_process(&fx.line, 2000), 4000);
+	zassert_equal(a.fired, 0);
+	co_timer_stop(&a.t);
+	zassert_false(co_timer_is_armed(&a.t));
+	zassert_equal(co_line_process(&fx.line, 10000), UINT64_MAX);
+	zassert_equal(a.fired, 0);
+	co_timer_stop(&a.t); /* stopping twice is harmless */
+}
+
+ZTEST(co_line, test_periodic_timer_rearmed_from_its_handler_catches_up)
+{
+	struct tagged_timer hb = {.tag = 5, .rearm_period = 100};
+
+	co_timer_init(&hb.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_start(&fx.line, &hb.t, 100);
+	/* Late by 3.5 periods: the handler runs for each missed deadline, then waits. */
+	zassert_equal(co_line_process(&fx.line, 450), 500);
+	zassert_equal(hb.fired, 4);
+}
+
+static struct can_frame tx_frame(uint32_t id)
+{
+	struct can_frame f = {.id = id, .dlc = 1, .data = {(uint8_t)id}};
+
+	return f;
+}
+
+ZTEST(co_line, test_send_goes_straight_to_the_sink)
+{
+	struct can_frame f = tx_frame(0x701);
+
+	zassert_ok(co_line_send(&fx.line, &f));
+	zassert_equal(fx.sent_len, 1);
+	zassert_equal(fx.sent[0].id, 0x701);
+}
+
+ZTEST(co_line, test_back_pressure_queues_frames_in_order)
+{
+	struct co_line_stats st;
+
+	fx.sink_result = -EAGAIN;
+	for (uint32_t i = 0; i < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE; i++) {
+		struct can_frame f = tx_frame(0x580 + i);
+
+		zassert_ok(co_line_send(&fx.line, &f), "queued, not an error");
+	}
+	zassert_equal(fx.sent_len, 0);
+
+	/* Driver still full: nothing moves. */
+	co_line_process(&fx.line, 0);
+	zassert_equal(fx.sent_len, 0);
+
+	fx.sink_result = 0;
+	co_line_process(&fx.line, 0);
+	zassert_equal(fx.sent_len, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+	for (int i = 0; i < fx.sent_len; i++) {
+		zassert_equal(fx.sent[i].id, 0x580 + i, "order kept");
+	}
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.tx_queued, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+	zassert_equal(st.tx_queue_max, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+	zassert_equal(st.tx_frames, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+	zassert_equal(st.tx_dropped, 0);
+}
+
+ZTEST(co_line, test_a_frame_sent_while_others_wait_queues_behind_them)
+{
+	struct can_frame f1 = tx_frame(0x181), f2 = tx_frame(0x182);
+
+	fx.sink_result = -ENOBUFS;
+	zassert_ok(co_line_send(&fx.line, &f1));
+	fx.sink_result = 0;
+	/* The driver would take f2 now, but f1 must go first. */
+	zassert_ok(co_line_send(&fx.line, &f2));
+	zassert_equal(fx.sent_len, 0);
+	co_line_process(&fx.line, 0);
+	zassert_equal(fx.sent_len, 2);
+	zassert_equal(fx.sent[0].id, 0x181);
+	zassert_equal(fx.sent[1].id, 0x182);
+}
+
+ZTEST(co_line, test_full_tx_queue_drops_counts_and_reports)
+{
+	struct co_line_stats st;
+	struct can_frame f = tx_frame(0x281);
+
+	fx.sink_result = -EAGAIN;
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE; i++) {
+		zassert_ok(co_line_send(&fx.line, &f));
+	}
+	zassert_equal(co_line_send(&fx.line, &f), -ENOBUFS);
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.tx_dropped, 1);
+	zassert_equal(fx.event_len, 1);
+	zassert_equal(fx.events[0], CO_LINE_EV_TX_OVERFLOW);
+}
+
+ZTEST(co_line, test_driver_error_is_returned_and_reported)
+{
+	struct can_frame f = tx_frame(0x181);
+	struct co_line_stats st;
+
+	fx.sink_result = -ENETDOWN;
+	zassert_equal(co_line_send(&fx.line, &f), -ENETDOWN);
+	zassert_equal(fx.event_len, 1);
+	zassert_equal(fx.events[0], CO_LINE_EV_TX_ERROR);
+	zassert_equal(fx.event_args[0], -ENETDOWN);
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.tx_errors, 1);
+	zassert_equal(st.tx_frames, 0);
+}
+
+ZTEST(co_line, test_wrap_safe_time_comparison)
+{
+	zassert_true(co_time_before_eq(5, 5));
+	zassert_true(co_time_before_eq(UINT64_MAX - 10, 5), "across the wrap");
+	zassert_false(co_time_before_eq(5, UINT64_MAX - 10));
+}
