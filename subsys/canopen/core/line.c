@@ -460,6 +460,9 @@ static int tx_submit(struct co_line *line, const struct can_frame *frame)
 
 	if (line->dev == NULL) {
 		err = line->sink(line, frame, line->sink_user_data);
+	} else if (!atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
+		/* Not started yet (a node's boot-up before co_line_start()): wait in the queue. */
+		err = -EAGAIN;
 	} else {
 		err = co_line_dev_send(line, frame);
 	}

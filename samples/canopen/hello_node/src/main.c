@@ -1,0 +1,191 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * hello_node: one CANopen device on one line. Heartbeat producer, node guarding, SDO server,
+ * an uptime counter (2000h) that the application updates every second, a setpoint (2001h)
+ * and a 128 KiB data buffer (2100h, DOMAIN) served by an object provider.
+ *
+ * The line is can_socketcan0 when it has an interface (--can-if=0:vcan0), else can_virtual0.
+ */
+
+#include <errno.h>
+#include <string.h>
+
+#include <zephyr/device.h>
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/line.h>
+#include <canopen/node.h>
+
+#include "cmdline.h"
+#include "posix_native_task.h"
+#include "hello_node_od.h"
+
+LOG_MODULE_REGISTER(hello_node, LOG_LEVEL_INF);
+
+#define DATA_INDEX    0x2100U
+#define DATA_CAPACITY (128U * 1024U)
+
+#define DEFAULT_NODE_ID 0x10U
+
+/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
+static uint32_t node_id_arg;
+
+static void add_options(void)
+{
+	static struct args_struct_t opts[] = {
+		{
+			.option = "node-id",
+			.name = "1..127",
+			.type = 'u',
+			.dest = &node_id_arg,
+			.descript = "CANopen node-ID of this device (default 16)",
+		},
+		ARG_TABLE_ENDMARKER,
+	};
+
+	native_add_command_line_opts(opts);
+}
+NATIVE_TASK(add_options, PRE_BOOT_1, 20);
+
+static struct co_line line;
+static struct co_node node;
+static struct hello_node_od_ram od_ram;
+static K_THREAD_STACK_DEFINE(line_stack, CONFIG_CANOPEN_LINE_STACK_SIZE);
+
+/*
+ * 2100h: a DOMAIN larger than any staging buffer. Chunks stream into a shadow buffer that
+ * becomes the value only when the last chunk arrived, so an aborted download leaves the old
+ * value intact.
+ */
+static struct {
+	uint8_t value[DATA_CAPACITY];
+	uint8_t shadow[DATA_CAPACITY];
+	uint32_t len;
+	uint32_t shadow_len;
+} data_buf;
+
+static uint32_t data_info(const struct co_od_provider *p, struct co_od_info *info)
+{
+	if (info->sub != 0U) {
+		return CO_SDO_AB_NO_SUB;
+	}
+	info->dtype = CO_DTYPE_DOMAIN;
+	info->access = CO_OD_ACCESS_RW;
+	info->flags = CO_OD_F_STREAM;
+	info->objcode = CO_OD_OBJ_VAR;
+	info->size = DATA_CAPACITY;
+	return 0;
+}
+
+static uint32_t data_length(const struct co_od_provider *p, const struct co_od_info *info)
+{
+	return data_buf.len;
+}
+
+static uint32_t data_read(const struct co_od_provider *p, const struct co_od_info *info,
+			  uint32_t offset, void *buf, size_t cap, size_t *len)
+{
+	size_t n = 0;
+
+	if (offset < data_buf.len) {
+		n = MIN(cap, (size_t)(data_buf.len - offset));
+		memcpy(buf, &data_buf.value[offset], n);
+	}
+	*len = n;
+	return 0;
+}
+
+static uint32_t data_write(const struct co_od_provider *p, const struct co_od_info *info,
+			   uint32_t offset, const void *data, size_t len, bool last)
+{
+	if (offset == 0U) {
+		data_buf.shadow_len = 0U;
+	}
+	if (offset != data_buf.shadow_len || len > DATA_CAPACITY - offset) {
+		return CO_SDO_AB_DATA_LONG;
+	}
+	memcpy(&data_buf.shadow[offset], data, len);
+	data_buf.shadow_len = offset + (uint32_t)len;
+	if (last) {
+		memcpy(data_buf.value, data_buf.shadow, data_buf.shadow_len);
+		data_buf.len = data_buf.shadow_len;
+	}
+	return 0;
+}
+
+static const struct co_od_provider_api data_api = {
+	.info = data_info,
+	.length = data_length,
+	.read = data_read,
+	.write = data_write,
+};
+
+static const struct co_od_provider data_provider = {
+	.api = &data_api,
+	.index_first = DATA_INDEX,
+	.index_last = DATA_INDEX,
+};
+
+/* Line 0: SocketCAN when an interface was given, else the virtual bus. */
+static const struct device *line_device(void)
+{
+	const struct device *dev = device_get_binding("can_socketcan0");
+
+	if (dev != NULL && device_is_ready(dev)) {
+		return dev;
+	}
+	return device_get_binding("can_virtual0");
+}
+
+int main(void)
+{
+	const struct device *can = line_device();
+	uint32_t seconds = 0;
+	int err;
+
+	if (node_id_arg == UINT32_MAX) {
+		node_id_arg = DEFAULT_NODE_ID;
+	}
+	if (node_id_arg < 1U || node_id_arg > 127U) {
+		LOG_ERR("--node-id must be 1..127 (got %u)", node_id_arg);
+		return 1;
+	}
+	if (can == NULL) {
+		LOG_ERR("no CAN controller");
+		return 1;
+	}
+	err = co_line_init(&line, "line0", can);
+	if (err == 0) {
+		err = co_node_init(&node, "hello", &line, &hello_node_od_def, &od_ram,
+				   (uint8_t)node_id_arg);
+	}
+	if (err == 0) {
+		err = co_od_provider_register(co_node_od(&node), &data_provider);
+	}
+	if (err == 0) {
+		err = co_line_start(&line, line_stack, K_THREAD_STACK_SIZEOF(line_stack),
+				    CONFIG_CANOPEN_LINE_THREAD_PRIORITY);
+	}
+	if (err == 0) {
+		err = co_node_start(&node);
+	}
+	if (err != 0) {
+		LOG_ERR("start failed (%d)", err);
+		return 1;
+	}
+	printk("hello_node: node %u up on %s\n", node_id_arg, can->name);
+
+	for (;;) {
+		k_sleep(K_SECONDS(1));
+		seconds++;
+		co_node_lock(&node);
+		(void)co_od_set_u32(co_node_od(&node), 0x2000, 0, seconds, CO_OD_WRITER_APP);
+		co_node_unlock(&node);
+	}
+	return 0;
+}
