@@ -152,11 +152,15 @@ struct co_line_stats {
 enum co_line_msg_kind {
 	CO_LINE_MSG_FRAME,
 	CO_LINE_MSG_WAKE,
+	/* A frame sent by a node of this line, for the line's other nodes. */
+	CO_LINE_MSG_LOCAL,
 };
 
 struct co_line_rx_msg {
 	struct can_frame frame;
 	uint64_t time_us;
+	/* CO_LINE_MSG_LOCAL: lock of the sending node, whose receivers skip the frame. */
+	const struct k_mutex *origin;
 	uint8_t kind;
 };
 
@@ -188,10 +192,13 @@ struct co_line {
 	struct co_line_stats stats;
 	/* Simulation mode: the time of the last co_line_rx()/co_line_process(). */
 	uint64_t sim_now;
+	/* Nodes attached; from two on, frames a node sends reach the others (local delivery). */
+	uint8_t n_nodes;
 
+	/* Received frames for the thread; in simulation, frames for local delivery only. */
+	struct k_msgq rxq;
 	/* Threaded mode. */
 	const struct device *dev;
-	struct k_msgq rxq;
 	char rxq_buf[CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE * sizeof(struct co_line_rx_msg)];
 	struct k_thread thread;
 	k_tid_t tid;
@@ -343,6 +350,25 @@ bool co_timer_is_armed(const struct co_timer *timer);
  * @retval -EIO Another driver error (reported as CO_LINE_EV_TX_ERROR).
  */
 int co_line_send(struct co_line *line, const struct can_frame *frame);
+
+/**
+ * @brief Send a frame on behalf of a node attached to the line.
+ *
+ * Like co_line_send(); in addition, when several nodes share the line, the frame is delivered
+ * to the receivers of the other nodes (the controller does not receive its own frames, but
+ * the other nodes are on the bus as much as any remote one). Receivers whose lock is
+ * @p origin do not get it. Local delivery happens in the line thread (in simulation: in the
+ * next co_line_process()), with the send time as reception time.
+ *
+ * @return As co_line_send().
+ */
+int co_line_send_from(struct co_line *line, const struct can_frame *frame,
+		      const struct k_mutex *origin);
+
+/**
+ * @brief Count one more node on the line (called by co_node_init()).
+ */
+void co_line_attach(struct co_line *line);
 
 /**
  * @brief Dispatch one received frame to its receivers.

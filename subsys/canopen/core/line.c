@@ -43,6 +43,8 @@ static void line_init_common(struct co_line *line, const char *name)
 	memset(line, 0, sizeof(*line));
 	line->name = name;
 	sys_slist_init(&line->timers);
+	k_msgq_init(&line->rxq, line->rxq_buf, sizeof(struct co_line_rx_msg),
+		    CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE);
 	k_mutex_init(&line->lock);
 	k_mutex_init(&line->tx_lock);
 }
@@ -61,8 +63,6 @@ int co_line_init(struct co_line *line, const char *name, const struct device *de
 	}
 	line_init_common(line, name);
 	line->dev = dev;
-	k_msgq_init(&line->rxq, line->rxq_buf, sizeof(struct co_line_rx_msg),
-		    CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE);
 	line->filter_std = -1;
 	line->filter_ext = -1;
 	return 0;
@@ -257,6 +257,12 @@ static void rx_call(struct co_line *line, struct co_rx *rx, const struct can_fra
 
 int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
 {
+	return co_line_dispatch(line, frame, now_us, NULL);
+}
+
+int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
+		     const struct k_mutex *origin)
+{
 	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
 	struct co_rx *batch[CONFIG_CANOPEN_LINE_RX_FANOUT];
 	int n = 0;
@@ -272,19 +278,23 @@ int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now
 		if (slot != 0U) {
 			for (struct co_rx *rx = line->slots[slot - 1U];
 			     rx != NULL && n < (int)ARRAY_SIZE(batch); rx = rx->next) {
-				batch[n++] = rx;
+				if (origin == NULL || rx->lock != origin) {
+					batch[n++] = rx;
+				}
 			}
 		}
 	}
 	for (struct co_rx *rx = line->others; rx != NULL && n < (int)ARRAY_SIZE(batch);
 	     rx = rx->next) {
-		if (rx_matches(rx, frame, ext)) {
+		if (rx_matches(rx, frame, ext) && (origin == NULL || rx->lock != origin)) {
 			batch[n++] = rx;
 		}
 	}
-	line->stats.rx_frames++;
-	if (n == 0) {
-		line->stats.rx_unhandled++;
+	if (origin == NULL) {
+		line->stats.rx_frames++;
+		if (n == 0) {
+			line->stats.rx_unhandled++;
+		}
 	}
 	k_mutex_unlock(&line->lock);
 
@@ -423,6 +433,10 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 		k_mutex_unlock(&line->lock);
 	}
 
+	if (line->dev == NULL) {
+		co_line_local_drain(line);
+	}
+
 	/* A handler may re-arm its timer for a deadline already passed; bound the work so a
 	 * zero-period timer cannot starve the line.
 	 */
@@ -448,6 +462,10 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 		}
 	}
 	co_line_tx_drain(line);
+	if (line->dev == NULL && k_msgq_num_used_get(&line->rxq) > 0U) {
+		/* Local frames sent by the handlers above are due at once. */
+		return now_us;
+	}
 	return co_line_next_deadline(line);
 }
 
@@ -521,6 +539,56 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 		co_line_report(line, CO_LINE_EV_TX_ERROR, err);
 	}
 	return err;
+}
+
+void co_line_attach(struct co_line *line)
+{
+	k_mutex_lock(&line->lock, K_FOREVER);
+	if (line->n_nodes < UINT8_MAX) {
+		line->n_nodes++;
+	}
+	k_mutex_unlock(&line->lock);
+}
+
+int co_line_send_from(struct co_line *line, const struct can_frame *frame,
+		      const struct k_mutex *origin)
+{
+	int err = co_line_send(line, frame);
+	uint8_t n_nodes;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	n_nodes = line->n_nodes;
+	k_mutex_unlock(&line->lock);
+
+	if (err == 0 && n_nodes > 1U) {
+		struct co_line_rx_msg msg = {
+			.frame = *frame,
+			.time_us = co_line_time(line),
+			.origin = origin,
+			.kind = CO_LINE_MSG_LOCAL,
+		};
+
+		if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
+			atomic_inc(&line->rx_overruns);
+			atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+		}
+	}
+	return err;
+}
+
+void co_line_local_drain(struct co_line *line)
+{
+	struct co_line_rx_msg msg;
+
+	/* Bounded: handlers may send (and so queue) more local frames. */
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE; i++) {
+		if (k_msgq_get(&line->rxq, &msg, K_NO_WAIT) != 0) {
+			break;
+		}
+		if (msg.kind == CO_LINE_MSG_LOCAL) {
+			co_line_dispatch(line, &msg.frame, msg.time_us, msg.origin);
+		}
+	}
 }
 
 void co_line_tx_drain(struct co_line *line)

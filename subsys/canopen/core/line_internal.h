@@ -31,6 +31,13 @@ int co_line_dev_send(struct co_line *line, const struct can_frame *frame);
 /* Retry frames that wait in the TX queue. */
 void co_line_tx_drain(struct co_line *line);
 
+/* Dispatch a frame; receivers whose lock is @p origin (the sending node's) are skipped. */
+int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
+		     const struct k_mutex *origin);
+
+/* Simulation: dispatch the frames waiting for local delivery. */
+void co_line_local_drain(struct co_line *line);
+
 /* Report an event to the line's event callback. */
 void co_line_report(struct co_line *line, enum co_line_event event, int arg);
 

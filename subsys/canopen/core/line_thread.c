@@ -125,6 +125,8 @@ static void line_thread(void *p1, void *p2, void *p3)
 			do {
 				if (msg.kind == CO_LINE_MSG_FRAME) {
 					co_line_rx(line, &msg.frame, msg.time_us);
+				} else if (msg.kind == CO_LINE_MSG_LOCAL) {
+					co_line_dispatch(line, &msg.frame, msg.time_us, msg.origin);
 				} else {
 					atomic_clear_bit(&line->flags, CO_LINE_F_WAKE_PENDING);
 				}

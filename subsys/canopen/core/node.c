@@ -33,6 +33,7 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
 	node->node_id = node_id;
 	node->pending_node_id = node_id;
 	node->nmt.state = CO_NMT_INITIALISING;
+	co_line_attach(line);
 
 	err = co_od_init(&node->od, def, ram, node_id);
 	if (err != 0) {
@@ -127,5 +128,5 @@ int co_node_set_pending_id(struct co_node *node, uint8_t node_id)
 
 int co_node_send(struct co_node *node, const struct can_frame *frame)
 {
-	return co_line_send(node->line, frame);
+	return co_line_send_from(node->line, frame, &node->lock);
 }

@@ -362,3 +362,39 @@ ZTEST(co_line, test_wrap_safe_time_comparison)
 	zassert_true(co_time_before_eq(UINT64_MAX - 10, 5), "across the wrap");
 	zassert_false(co_time_before_eq(5, UINT64_MAX - 10));
 }
+
+ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
+{
+	struct k_mutex node_a, node_b;
+	struct co_rx ra, rb;
+	struct can_frame f = std_frame(0x701, 1);
+
+	k_mutex_init(&node_a);
+	k_mutex_init(&node_b);
+	rx_fill(&ra, 0x701, 0x7ff, false, 1);
+	ra.lock = &node_a;
+	rx_fill(&rb, 0x701, 0x7ff, false, 2);
+	rb.lock = &node_b;
+	zassert_ok(co_rx_register(&fx.line, &ra));
+	zassert_ok(co_rx_register(&fx.line, &rb));
+
+	/* One node on the line: nothing to deliver locally. */
+	co_line_attach(&fx.line);
+	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
+	zassert_equal(co_line_process(&fx.line, 10), UINT64_MAX);
+	zassert_equal(fx.log_len, 0);
+
+	co_line_attach(&fx.line);
+	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
+	zassert_equal(fx.sent_len, 2, "the frame still goes to the bus");
+	zassert_equal(fx.log_len, 0, "delivered in the line's context, not inside the send");
+	co_line_process(&fx.line, 20);
+	zassert_equal(fx.log_len, 1);
+	zassert_equal(fx.log[0], 2, "only the other node gets it");
+	zassert_equal(fx.log_time[0], 10, "reception time = send time");
+
+	struct co_line_stats st;
+
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.rx_frames, 0, "local frames are not counted as received from the bus");
+}
