@@ -1,0 +1,7 @@
+#include <zephyr/ztest.h>
+
+ZTEST_SUITE(broken, NULL, NULL, NULL, NULL, NULL);
+
+ZTEST(broken, test_one)
+{
+}
