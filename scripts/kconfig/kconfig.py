@@ -34,8 +34,12 @@ def user_assignments(kconf):
 
 
 def value_did_not_stick(sym):
-    if sym.choice is not None and sym.user_value == 2 and sym.choice.selection is not sym:
-        return True
+    if sym.choice is not None and sym.user_value == 2:
+        # A later fragment picking another symbol of the same choice overrides this one, as
+        # any later assignment does; only a pick that the choice cannot take is an error.
+        if sym.choice.user_selection is not sym:
+            return False
+        return sym.choice.selection is not sym
     user = sym.user_value
     if sym.orig_type in (kconfiglib.BOOL, kconfiglib.TRISTATE):
         return sym.tri_value != user

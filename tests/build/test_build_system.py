@@ -174,3 +174,29 @@ def test_sanitizer_option_reaches_the_compiler(tmp_path):
     assert configure(app, build, "-DCONFIG_UBSAN=y").returncode == 0
     commands = (build / "compile_commands.json").read_text()
     assert "-fsanitize=undefined" in commands
+
+
+def test_later_fragment_may_pick_another_choice_member(tmp_path):
+    app = make_app(tmp_path, prj="CONFIG_TEST_CHOICE_A=y\n", extra="CONFIG_TEST_CHOICE_B=y\n")
+    kconfig = (app / "Kconfig").read_text().replace('source "Kconfig.safeline"', """\
+choice TEST_CHOICE
+	prompt "test choice"
+	default TEST_CHOICE_A
+
+config TEST_CHOICE_A
+	bool "A"
+
+config TEST_CHOICE_B
+	bool "B"
+
+endchoice
+
+source "Kconfig.safeline"
+""")
+    (app / "Kconfig").write_text(kconfig)
+    build = tmp_path / "build"
+    r = configure(app, build, f"-DEXTRA_CONF_FILE={app / 'extra.conf'}")
+    assert r.returncode == 0, r.stderr
+    cfg = dotconfig(build)
+    assert cfg.get("CONFIG_TEST_CHOICE_B") == "y"
+    assert "CONFIG_TEST_CHOICE_A" not in cfg
