@@ -1,0 +1,747 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * SocketCAN controllers for native_posix: can_socketcan<i> is a raw CAN socket on a Linux
+ * interface (Kconfig CAN_SOCKETCAN_IFNAMES, overridden by --can-if=<i>:<ifname>).
+ *
+ * This file sees only RTOS headers; Linux is behind socketcan_host.h (both define struct
+ * can_frame). One receive thread per controller blocks in recvmsg(); it delivers frames,
+ * turns the echo of our own frames into TX completions (first in, first out, as the kernel
+ * keeps the order) and error frames into enum can_state.
+ *
+ * Locking: lock guards state and the in-flight FIFO; rx_lock is held while receive
+ * callbacks run and while filters change. No callback runs with lock held.
+ */
+
+#include <errno.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <zephyr/device.h>
+#include <zephyr/drivers/can.h>
+#include <zephyr/init.h>
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+#include <zephyr/sys/util.h>
+
+#include "can_socketcan.h"
+#include "cmdline.h"
+#include "posix_board_if.h"
+#include "posix_native_task.h"
+#include "socketcan_host.h"
+
+LOG_MODULE_REGISTER(can_socketcan, CONFIG_CAN_LOG_LEVEL);
+
+#define SC_NUM_CTRL    CONFIG_CAN_SOCKETCAN_NUM_CONTROLLERS
+#define SC_MAX_FILTERS CONFIG_CAN_SOCKETCAN_MAX_FILTERS
+#define SC_TXQ_SIZE    CONFIG_CAN_SOCKETCAN_TX_QUEUE_SIZE
+#define SC_IFNAMSIZ    16
+/* The kernel's interface decides the bit rate; these bound what can_set_bitrate() accepts. */
+#define SC_MIN_BITRATE 10000U
+#define SC_MAX_BITRATE 1000000U
+
+BUILD_ASSERT(SC_NUM_CTRL <= 8, "the driver defines up to 8 controllers");
+
+struct sc_filter {
+	can_rx_callback_t cb; /* NULL: free */
+	void *user_data;
+	struct can_filter filter;
+};
+
+struct sc_tx {
+	can_tx_callback_t cb;
+	void *user_data;
+};
+
+struct sc_config {
+	struct can_driver_config common; /* first, for the generic API */
+	uint8_t index;
+};
+
+struct sc_data {
+	struct can_driver_data common; /* first, for the generic API */
+	const struct device *dev;
+	char ifname[SC_IFNAMSIZ];
+	int fd;
+	/* guarded by lock */
+	struct k_mutex lock;
+	enum can_state state;
+	struct can_bus_err_cnt err_cnt;
+	uint32_t bitrate;
+	struct sc_tx inflight[SC_TXQ_SIZE]; /* FIFO of frames awaiting their echo */
+	uint16_t head;
+	uint16_t count;
+	uint32_t stale_echoes; /* echoes still due for frames aborted by stop/bus-off */
+	struct k_sem tx_slots;
+	struct k_sem echo_seen; /* given on every echo: room in the kernel queue again */
+	/* guarded by rx_lock */
+	struct k_mutex rx_lock;
+	struct sc_filter filters[SC_MAX_FILTERS];
+	struct k_thread rx_thread;
+};
+
+K_THREAD_STACK_ARRAY_DEFINE(sc_stacks, SC_NUM_CTRL, CONFIG_CAN_SOCKETCAN_RX_THREAD_STACK_SIZE);
+
+/* --can-if overrides, filled in before the kernel starts (PRE_BOOT_1). */
+static char sc_ifname_override[SC_NUM_CTRL][SC_IFNAMSIZ];
+
+static void sc_can_if_found(char *argv, int offset)
+{
+	const char *value = argv + offset;
+	char *end = NULL;
+	long index = strtol(value, &end, 10);
+
+	if (end == value || *end != ':' || index < 0 || index >= SC_NUM_CTRL || end[1] == '\0' ||
+	    strlen(end + 1) >= SC_IFNAMSIZ) {
+		posix_print_error_and_exit("--can-if=%s: expected <controller 0..%d>:<ifname> "
+					   "(at most %d characters)\n",
+					   value, SC_NUM_CTRL - 1, SC_IFNAMSIZ - 1);
+	}
+	strcpy(sc_ifname_override[index], end + 1);
+}
+
+static void sc_add_options(void)
+{
+	static struct args_struct_t opts[] = {
+		{
+			.option = "can-if",
+			.name = "controller:ifname",
+			.type = 's',
+			.dest = NULL,
+			.call_when_found = sc_can_if_found,
+			.descript = "Use Linux CAN interface <ifname> for SocketCAN controller "
+				    "can_socketcan<controller> (repeatable), e.g. --can-if=0:vcan0",
+		},
+		ARG_TABLE_ENDMARKER,
+	};
+
+	native_add_command_line_opts(opts);
+}
+
+NATIVE_TASK(sc_add_options, PRE_BOOT_1, 10);
+
+/* The i-th name of the Kconfig list, or "" if the list is shorter. */
+static void sc_kconfig_ifname(int index, char out[SC_IFNAMSIZ])
+{
+	const char *p = CONFIG_CAN_SOCKETCAN_IFNAMES;
+
+	out[0] = '\0';
+	for (int i = 0; i < index && p != NULL; i++) {
+		p = strchr(p, ',');
+		p = (p != NULL) ? p + 1 : NULL;
+	}
+	if (p != NULL) {
+		size_t len = strcspn(p, ",");
+
+		if (len < SC_IFNAMSIZ) {
+			memcpy(out, p, len);
+			out[len] = '\0';
+		}
+	}
+}
+
+/*
+ * Interface of controller @p index: the --can-if override, else the Kconfig list entry.
+ * "@<j>" stands for controller j's interface (two controllers on one bus, e.g. "vcan0,@0").
+ */
+static void sc_resolve_ifname(int index, char out[SC_IFNAMSIZ])
+{
+	for (int depth = 0; depth < SC_NUM_CTRL; depth++) {
+		if (sc_ifname_override[index][0] != '\0') {
+			strcpy(out, sc_ifname_override[index]);
+		} else {
+			sc_kconfig_ifname(index, out);
+		}
+		if (out[0] != '@') {
+			return;
+		}
+		index = atoi(&out[1]);
+		if (index < 0 || index >= SC_NUM_CTRL) {
+			break;
+		}
+	}
+	out[0] = '\0';
+}
+
+static inline struct sc_data *sc_data(const struct device *dev)
+{
+	return (struct sc_data *)dev->data;
+}
+
+/* Microseconds on the kernel's uptime clock at which the host received a frame. */
+static uint64_t sc_rx_time_us(uint64_t rx_mono_ns)
+{
+	uint64_t up_ns = k_ticks_to_ns_floor64((uint64_t)k_uptime_ticks());
+	uint64_t host_now = socketcan_host_mono_ns();
+	uint64_t age = (rx_mono_ns != 0U && host_now > rx_mono_ns) ? host_now - rx_mono_ns : 0U;
+
+	return ((age < up_ns) ? up_ns - age : 0U) / 1000U;
+}
+
+/* Takes the oldest in-flight entry; returns false if there is none. Under lock. */
+static bool sc_pop_locked(struct sc_data *d, struct sc_tx *out)
+{
+	if (d->count == 0U) {
+		return false;
+	}
+	*out = d->inflight[d->head];
+	d->head = (uint16_t)((d->head + 1U) % SC_TXQ_SIZE);
+	d->count--;
+
+	return true;
+}
+
+/* Aborts every in-flight frame: their echoes will be ignored. Under lock. */
+static int sc_abort_locked(struct sc_data *d, struct sc_tx out[SC_TXQ_SIZE])
+{
+	int n = 0;
+
+	while (sc_pop_locked(d, &out[n])) {
+		d->stale_echoes++;
+		n++;
+	}
+
+	return n;
+}
+
+static void sc_run_aborted(struct sc_data *d, const struct sc_tx *t, int n, int error)
+{
+	for (int i = 0; i < n; i++) {
+		k_sem_give(&d->tx_slots);
+		if (t[i].cb != NULL) {
+			t[i].cb(d->dev, error, t[i].user_data);
+		}
+	}
+}
+
+static void sc_deliver(struct sc_data *d, const struct can_frame *frame)
+{
+	k_mutex_lock(&d->rx_lock, K_FOREVER);
+	for (int i = 0; i < SC_MAX_FILTERS; i++) {
+		struct sc_filter *f = &d->filters[i];
+
+		if (f->cb != NULL && can_frame_matches_filter(frame, &f->filter)) {
+			struct can_frame copy = *frame;
+
+			f->cb(d->dev, &copy, f->user_data);
+		}
+	}
+	k_mutex_unlock(&d->rx_lock);
+}
+
+static void sc_on_echo(struct sc_data *d, const struct can_frame *frame)
+{
+	struct sc_tx tx;
+	bool have;
+	bool loopback;
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (d->stale_echoes > 0U) {
+		d->stale_echoes--;
+		have = false;
+	} else {
+		have = sc_pop_locked(d, &tx);
+	}
+	loopback = d->common.started && (d->common.mode & CAN_MODE_LOOPBACK) != 0U;
+	k_mutex_unlock(&d->lock);
+
+	k_sem_give(&d->echo_seen);
+	if (loopback) {
+		sc_deliver(d, frame);
+	}
+	if (have) {
+		k_sem_give(&d->tx_slots);
+		if (tx.cb != NULL) {
+			tx.cb(d->dev, 0, tx.user_data);
+		}
+	}
+}
+
+static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_frame *hf)
+{
+	struct socketcan_host_error err;
+	struct sc_tx aborted[SC_TXQ_SIZE];
+	int n_aborted = 0;
+	enum can_state state;
+	struct can_bus_err_cnt cnt;
+	can_state_change_callback_t cb = NULL;
+	void *cb_data = NULL;
+	bool changed;
+
+	socketcan_host_decode_error(hf, &err);
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (err.has_counters) {
+		d->err_cnt.tx_err_cnt = err.tx_err_cnt;
+		d->err_cnt.rx_err_cnt = err.rx_err_cnt;
+	}
+	switch (err.state) {
+	case SOCKETCAN_HOST_STATE_ACTIVE:
+		state = CAN_STATE_ERROR_ACTIVE;
+		break;
+	case SOCKETCAN_HOST_STATE_WARNING:
+		state = CAN_STATE_ERROR_WARNING;
+		break;
+	case SOCKETCAN_HOST_STATE_PASSIVE:
+		state = CAN_STATE_ERROR_PASSIVE;
+		break;
+	case SOCKETCAN_HOST_STATE_BUS_OFF:
+		state = CAN_STATE_BUS_OFF;
+		break;
+	default:
+		/* a protocol or transceiver error without news about the state */
+		state = d->state;
+		break;
+	}
+	changed = state != d->state;
+	d->state = state;
+	cnt = d->err_cnt;
+	if (changed && d->common.started) {
+		cb = d->common.state_change_cb;
+		cb_data = d->common.state_change_cb_user_data;
+		if (state == CAN_STATE_BUS_OFF) {
+			n_aborted = sc_abort_locked(d, aborted);
+		}
+	}
+	k_mutex_unlock(&d->lock);
+
+	if (changed) {
+		LOG_INF("%s (%s): state %d, tx %u rx %u", d->dev->name, d->ifname, (int)state,
+			cnt.tx_err_cnt, cnt.rx_err_cnt);
+	}
+	sc_run_aborted(d, aborted, n_aborted, -ENETUNREACH);
+	if (cb != NULL) {
+		cb(d->dev, state, cnt, cb_data);
+	}
+}
+
+static void sc_rx_thread(void *p1, void *p2, void *p3)
+{
+	struct sc_data *d = p1;
+	struct socketcan_host_frame hf;
+	struct can_frame frame;
+	uint64_t rx_ns;
+	bool own;
+	int last_err = 0;
+
+	for (;;) {
+		int rc = socketcan_host_recv(d->fd, &hf, &rx_ns, &own);
+
+		if (rc == -EINTR) {
+			continue;
+		}
+		if (rc < 0) {
+			/*
+			 * A socket error (e.g. ENETDOWN when the interface goes down) is reported
+			 * once per reading and consumed by it; only a dead socket ends the thread.
+			 */
+			if (rc != last_err) {
+				LOG_WRN("%s (%s): receive error %d", d->dev->name, d->ifname, rc);
+				last_err = rc;
+			}
+			if (rc == -EBADF || rc == -ENOTSOCK) {
+				return;
+			}
+			continue;
+		}
+		last_err = 0;
+
+		if ((hf.flags & SOCKETCAN_HOST_F_ERR) != 0U) {
+			sc_on_error_frame(d, &hf);
+			continue;
+		}
+
+		memset(&frame, 0, sizeof(frame));
+		frame.id = hf.id;
+		frame.dlc = hf.dlc;
+		frame.flags =
+			(uint8_t)(((hf.flags & SOCKETCAN_HOST_F_IDE) != 0U ? CAN_FRAME_IDE : 0U) |
+				  ((hf.flags & SOCKETCAN_HOST_F_RTR) != 0U ? CAN_FRAME_RTR : 0U));
+		memcpy(frame.data, hf.data, sizeof(frame.data));
+#if defined(CONFIG_CAN_RX_TIMESTAMP)
+		frame.timestamp = (uint16_t)sc_rx_time_us(rx_ns);
+#endif
+
+		if (own) {
+			sc_on_echo(d, &frame);
+		} else if (d->common.started) {
+			/* started is a single aligned word: a stale read only delays a stop */
+			sc_deliver(d, &frame);
+		}
+	}
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Driver API                                                                                 */
+
+static int sc_get_capabilities(const struct device *dev, can_mode_t *cap)
+{
+	*cap = CAN_MODE_LOOPBACK;
+
+	return 0;
+}
+
+static int sc_start(const struct device *dev)
+{
+	struct sc_data *d = sc_data(dev);
+	int rc = 0;
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (d->common.started) {
+		rc = -EALREADY;
+	} else if (d->fd < 0) {
+		rc = -EIO;
+	} else {
+		d->state = CAN_STATE_ERROR_ACTIVE;
+		d->err_cnt.tx_err_cnt = 0U;
+		d->err_cnt.rx_err_cnt = 0U;
+		d->common.started = true;
+	}
+	k_mutex_unlock(&d->lock);
+
+	return rc;
+}
+
+static int sc_stop(const struct device *dev)
+{
+	struct sc_data *d = sc_data(dev);
+	struct sc_tx aborted[SC_TXQ_SIZE];
+	int n;
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (!d->common.started) {
+		k_mutex_unlock(&d->lock);
+		return -EALREADY;
+	}
+	d->common.started = false;
+	n = sc_abort_locked(d, aborted);
+	k_mutex_unlock(&d->lock);
+	sc_run_aborted(d, aborted, n, -ENETDOWN);
+
+	return 0;
+}
+
+static int sc_set_mode(const struct device *dev, can_mode_t mode)
+{
+	struct sc_data *d = sc_data(dev);
+	int rc = 0;
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (d->common.started) {
+		rc = -EBUSY;
+	} else if ((mode & ~(can_mode_t)CAN_MODE_LOOPBACK) != 0U) {
+		rc = -ENOTSUP;
+	} else {
+		d->common.mode = mode;
+	}
+	k_mutex_unlock(&d->lock);
+
+	return rc;
+}
+
+static int sc_set_bitrate(const struct device *dev, uint32_t bitrate)
+{
+	struct sc_data *d = sc_data(dev);
+	int rc = 0;
+
+	/* Only recorded: the interface's bit rate is set on the host (ip link ... bitrate). */
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (d->common.started) {
+		rc = -EBUSY;
+	} else {
+		d->bitrate = bitrate;
+	}
+	k_mutex_unlock(&d->lock);
+
+	return rc;
+}
+
+/* Linux errno from the socket -> the CAN API's codes. */
+static int sc_map_send_error(struct sc_data *d, int rc)
+{
+	switch (rc) {
+	case -ENETDOWN:
+	case -ENXIO:
+	case -ENODEV:
+		return -ENETDOWN;
+	case -EAGAIN:
+	case -EINVAL:
+		return rc;
+	default:
+		LOG_WRN("%s (%s): send failed: %d", d->dev->name, d->ifname, rc);
+		return -EIO;
+	}
+}
+
+static int sc_send(const struct device *dev, const struct can_frame *frame, k_timeout_t timeout,
+		   can_tx_callback_t callback, void *user_data)
+{
+	struct sc_data *d = sc_data(dev);
+	struct socketcan_host_frame hf = {0};
+	k_timepoint_t end = sys_timepoint_calc(timeout);
+	int rc = 0;
+
+	if ((frame->flags & ~(CAN_FRAME_IDE | CAN_FRAME_RTR)) != 0U) {
+		return -ENOTSUP;
+	}
+	hf.id = frame->id;
+	hf.dlc = frame->dlc;
+	hf.flags = (uint8_t)(((frame->flags & CAN_FRAME_IDE) != 0U ? SOCKETCAN_HOST_F_IDE : 0U) |
+			     ((frame->flags & CAN_FRAME_RTR) != 0U ? SOCKETCAN_HOST_F_RTR : 0U));
+	memcpy(hf.data, frame->data, sizeof(hf.data));
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (!d->common.started) {
+		rc = -ENETDOWN;
+	} else if (d->state == CAN_STATE_BUS_OFF) {
+		rc = -ENETUNREACH;
+	}
+	k_mutex_unlock(&d->lock);
+	if (rc != 0) {
+		return rc;
+	}
+
+	if (k_sem_take(&d->tx_slots, timeout) != 0) {
+		return -EAGAIN;
+	}
+
+	for (;;) {
+		k_mutex_lock(&d->lock, K_FOREVER);
+		if (!d->common.started) {
+			rc = -ENETDOWN;
+		} else if (d->state == CAN_STATE_BUS_OFF) {
+			rc = -ENETUNREACH;
+		} else {
+			/* Queued before the write: the echo may come before send() returns. */
+			uint16_t tail = (uint16_t)((d->head + d->count) % SC_TXQ_SIZE);
+
+			d->inflight[tail].cb = callback;
+			d->inflight[tail].user_data = user_data;
+			d->count++;
+			rc = socketcan_host_send(d->fd, &hf);
+			if (rc != 0) {
+				d->count--;
+			}
+		}
+		k_mutex_unlock(&d->lock);
+
+		if (rc == 0) {
+			return 0;
+		}
+		if (rc != -EAGAIN) {
+			break;
+		}
+		/* The kernel's queue is full: wait for one of our frames to leave, or time out. */
+		if (k_sem_take(&d->echo_seen, sys_timepoint_timeout(end)) != 0) {
+			break;
+		}
+	}
+	k_sem_give(&d->tx_slots);
+
+	return (rc == -EAGAIN || rc == -ENETDOWN || rc == -ENETUNREACH) ? rc
+									: sc_map_send_error(d, rc);
+}
+
+static int sc_add_rx_filter(const struct device *dev, can_rx_callback_t callback, void *user_data,
+			    const struct can_filter *filter)
+{
+	struct sc_data *d = sc_data(dev);
+	int id = -ENOSPC;
+
+	k_mutex_lock(&d->rx_lock, K_FOREVER);
+	for (int i = 0; i < SC_MAX_FILTERS; i++) {
+		if (d->filters[i].cb == NULL) {
+			d->filters[i].cb = callback;
+			d->filters[i].user_data = user_data;
+			d->filters[i].filter = *filter;
+			id = i;
+			break;
+		}
+	}
+	k_mutex_unlock(&d->rx_lock);
+
+	return id;
+}
+
+static void sc_remove_rx_filter(const struct device *dev, int filter_id)
+{
+	struct sc_data *d = sc_data(dev);
+
+	if (filter_id < 0 || filter_id >= SC_MAX_FILTERS) {
+		return;
+	}
+	k_mutex_lock(&d->rx_lock, K_FOREVER);
+	d->filters[filter_id].cb = NULL;
+	k_mutex_unlock(&d->rx_lock);
+}
+
+static int sc_get_state(const struct device *dev, enum can_state *state,
+			struct can_bus_err_cnt *err_cnt)
+{
+	struct sc_data *d = sc_data(dev);
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	if (state != NULL) {
+		*state = d->common.started ? d->state : CAN_STATE_STOPPED;
+	}
+	if (err_cnt != NULL) {
+		*err_cnt = d->err_cnt;
+	}
+	k_mutex_unlock(&d->lock);
+
+	return 0;
+}
+
+static int sc_recover(const struct device *dev, k_timeout_t timeout)
+{
+	/* Manual recovery is not offered: the Linux interface recovers (restart-ms). */
+	return -ENOTSUP;
+}
+
+static void sc_set_state_change_callback(const struct device *dev,
+					 can_state_change_callback_t callback, void *user_data)
+{
+	struct sc_data *d = sc_data(dev);
+
+	k_mutex_lock(&d->lock, K_FOREVER);
+	d->common.state_change_cb = callback;
+	d->common.state_change_cb_user_data = user_data;
+	k_mutex_unlock(&d->lock);
+}
+
+static int sc_get_max_filters(const struct device *dev, bool ide)
+{
+	return SC_MAX_FILTERS;
+}
+
+static const struct can_driver_api sc_api;
+
+static bool sc_is_ours(const struct device *dev)
+{
+	return dev != NULL && dev->api == &sc_api;
+}
+
+const char *can_socketcan_ifname(const struct device *dev)
+{
+	return sc_is_ours(dev) ? sc_data(dev)->ifname : NULL;
+}
+
+int can_socketcan_inject_state(const struct device *dev, enum can_state state)
+{
+	static const enum socketcan_host_state host_state[] = {
+		[CAN_STATE_ERROR_ACTIVE] = SOCKETCAN_HOST_STATE_ACTIVE,
+		[CAN_STATE_ERROR_WARNING] = SOCKETCAN_HOST_STATE_WARNING,
+		[CAN_STATE_ERROR_PASSIVE] = SOCKETCAN_HOST_STATE_PASSIVE,
+		[CAN_STATE_BUS_OFF] = SOCKETCAN_HOST_STATE_BUS_OFF,
+	};
+
+	if (!sc_is_ours(dev) || (int)state < 0 || state > CAN_STATE_BUS_OFF) {
+		return -EINVAL;
+	}
+	if (sc_data(dev)->fd < 0) {
+		return -EIO;
+	}
+
+	return socketcan_host_send_state(sc_data(dev)->fd, host_state[state]);
+}
+
+static const struct can_driver_api sc_api = {
+	.get_capabilities = sc_get_capabilities,
+	.start = sc_start,
+	.stop = sc_stop,
+	.set_mode = sc_set_mode,
+	.set_bitrate = sc_set_bitrate,
+	.send = sc_send,
+	.add_rx_filter = sc_add_rx_filter,
+	.remove_rx_filter = sc_remove_rx_filter,
+	.recover = sc_recover,
+	.get_state = sc_get_state,
+	.set_state_change_callback = sc_set_state_change_callback,
+	.get_max_filters = sc_get_max_filters,
+};
+
+static int sc_init(const struct device *dev)
+{
+	const struct sc_config *cfg = dev->config;
+	struct sc_data *d = dev->data;
+
+	d->dev = dev;
+	d->fd = -1;
+	d->state = CAN_STATE_ERROR_ACTIVE;
+	d->bitrate = cfg->common.bitrate;
+	d->common.mode = CAN_MODE_NORMAL;
+	k_mutex_init(&d->lock);
+	k_mutex_init(&d->rx_lock);
+	k_sem_init(&d->tx_slots, SC_TXQ_SIZE, SC_TXQ_SIZE);
+	k_sem_init(&d->echo_seen, 0, 1);
+
+	sc_resolve_ifname(cfg->index, d->ifname);
+	if (d->ifname[0] == '\0') {
+		LOG_DBG("%s: no interface (CONFIG_CAN_SOCKETCAN_IFNAMES or --can-if=%u:<ifname>)",
+			dev->name, cfg->index);
+		return -ENODEV;
+	}
+
+	d->fd = socketcan_host_open(d->ifname);
+	if (d->fd < 0) {
+		int rc = d->fd;
+
+		LOG_ERR("%s: cannot open CAN interface %s: %s (%d)", dev->name, d->ifname,
+			rc == -EAFNOSUPPORT ? "the kernel has no AF_CAN (use scripts/vcan-vm)"
+			: rc == -ENODEV     ? "no such interface"
+					    : "socket error",
+			rc);
+		d->fd = -1;
+		return rc;
+	}
+
+	k_thread_create(&d->rx_thread, sc_stacks[cfg->index],
+			K_THREAD_STACK_SIZEOF(sc_stacks[cfg->index]), sc_rx_thread, d, NULL, NULL,
+			CONFIG_CAN_SOCKETCAN_RX_THREAD_PRIORITY, 0, K_NO_WAIT);
+	k_thread_name_set(&d->rx_thread, dev->name);
+	LOG_DBG("%s on %s", dev->name, d->ifname);
+
+	return 0;
+}
+
+#define SC_DEFINE(i)                                                                               \
+	static struct sc_data sc_data_##i;                                                         \
+	static const struct sc_config sc_config_##i = {                                            \
+		.common =                                                                          \
+			{                                                                          \
+				.min_bitrate = SC_MIN_BITRATE,                                     \
+				.max_bitrate = SC_MAX_BITRATE,                                     \
+				.bitrate = 500000U,                                                \
+			},                                                                         \
+		.index = (i),                                                                      \
+	};                                                                                         \
+	DEVICE_DEFINE(can_socketcan##i, "can_socketcan" #i, sc_init, NULL, &sc_data_##i,           \
+		      &sc_config_##i, POST_KERNEL, 50, &sc_api)
+
+SC_DEFINE(0);
+#if SC_NUM_CTRL > 1
+SC_DEFINE(1);
+#endif
+#if SC_NUM_CTRL > 2
+SC_DEFINE(2);
+#endif
+#if SC_NUM_CTRL > 3
+SC_DEFINE(3);
+#endif
+#if SC_NUM_CTRL > 4
+SC_DEFINE(4);
+#endif
+#if SC_NUM_CTRL > 5
+SC_DEFINE(5);
+#endif
+#if SC_NUM_CTRL > 6
+SC_DEFINE(6);
+#endif
+#if SC_NUM_CTRL > 7
+SC_DEFINE(7);
+#endif

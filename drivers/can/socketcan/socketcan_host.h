@@ -1,0 +1,84 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * Plain-C boundary between the SocketCAN driver (RTOS side, socketcan.c) and the Linux side
+ * (socketcan_host.c). Linux and Zephyr both define struct can_frame, so neither side's headers
+ * may reach the other: this header uses only <stdbool.h>/<stdint.h>.
+ *
+ * All functions return 0 (or a value >= 0) on success and a negative errno on failure.
+ */
+
+#ifndef SAFELINE_DRIVERS_CAN_SOCKETCAN_HOST_H_
+#define SAFELINE_DRIVERS_CAN_SOCKETCAN_HOST_H_
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Frame flags at the boundary. */
+#define SOCKETCAN_HOST_F_IDE 0x01U /* 29-bit identifier */
+#define SOCKETCAN_HOST_F_RTR 0x02U /* remote frame */
+#define SOCKETCAN_HOST_F_ERR 0x04U /* error frame (received only; see decode_error) */
+
+struct socketcan_host_frame {
+	uint32_t id; /* identifier, or the error class bits of an error frame */
+	uint8_t dlc;
+	uint8_t flags;
+	uint8_t data[8];
+};
+
+/* What an error frame says about the controller. */
+enum socketcan_host_state {
+	SOCKETCAN_HOST_STATE_NONE, /* no state information (e.g. only a protocol error) */
+	SOCKETCAN_HOST_STATE_ACTIVE,
+	SOCKETCAN_HOST_STATE_WARNING,
+	SOCKETCAN_HOST_STATE_PASSIVE,
+	SOCKETCAN_HOST_STATE_BUS_OFF,
+};
+
+struct socketcan_host_error {
+	enum socketcan_host_state state;
+	bool has_counters; /* the frame carried the error counters (CAN_ERR_CNT) */
+	uint8_t tx_err_cnt;
+	uint8_t rx_err_cnt;
+};
+
+/*
+ * Open a raw CAN socket bound to @p ifname that receives every frame on the interface, its own
+ * frames back (as TX confirmations) and all error frames, with kernel receive timestamps.
+ * Returns the socket (>= 0) or -errno (-ENODEV: no such interface; -EAFNOSUPPORT: no AF_CAN).
+ */
+int socketcan_host_open(const char *ifname);
+
+void socketcan_host_close(int fd);
+
+/* Whether the interface is administratively and operationally up: 1, 0, or -errno. */
+int socketcan_host_is_up(const char *ifname);
+
+/*
+ * Queue a frame without blocking. -EAGAIN when the interface's queue is full (-ENOBUFS from
+ * the kernel is reported as -EAGAIN), -ENETDOWN when the interface is down, other -errno as is.
+ */
+int socketcan_host_send(int fd, const struct socketcan_host_frame *frame);
+
+/*
+ * Block until a frame arrives. @p rx_mono_ns gets the kernel's receive time on
+ * CLOCK_MONOTONIC (0 if the kernel gave none), @p own tells whether it is the echo of a frame
+ * sent through this socket. -EINTR if interrupted by a signal.
+ */
+int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_mono_ns,
+			bool *own);
+
+/* Decode an error frame (flags has SOCKETCAN_HOST_F_ERR). */
+void socketcan_host_decode_error(const struct socketcan_host_frame *frame,
+				 struct socketcan_host_error *err);
+
+/* Write the error frame that announces @p state (test helper; vcan loops it back). */
+int socketcan_host_send_state(int fd, enum socketcan_host_state state);
+
+/* CLOCK_MONOTONIC now, in nanoseconds. */
+uint64_t socketcan_host_mono_ns(void);
+
+#endif /* SAFELINE_DRIVERS_CAN_SOCKETCAN_HOST_H_ */
