@@ -1,0 +1,74 @@
+/*
+ * Copyright (c) 2024 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/* Host side of the file storage backend (native_posix only): POSIX file calls. */
+
+#include <errno.h>
+#include <fcntl.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "storage_file_host.h"
+
+int co_storage_host_open(const char *path)
+{
+	int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+
+	return fd >= 0 ? fd : -errno;
+}
+
+int co_storage_host_pread(int fd, uint32_t offset, void *buf, size_t len)
+{
+	size_t done = 0;
+
+	while (done < len) {
+		ssize_t n = pread(fd, (char *)buf + done, len - done, (off_t)offset + (off_t)done);
+
+		if (n < 0) {
+			if (errno == EINTR) {
+				continue;
+			}
+			return -errno;
+		}
+		if (n == 0) {
+			memset((char *)buf + done, 0xFF, len - done);
+			break;
+		}
+		done += (size_t)n;
+	}
+	return 0;
+}
+
+int co_storage_host_pwrite(int fd, uint32_t offset, const void *buf, size_t len)
+{
+	size_t done = 0;
+
+	while (done < len) {
+		ssize_t n = pwrite(fd, (const char *)buf + done, len - done,
+				   (off_t)offset + (off_t)done);
+
+		if (n < 0) {
+			if (errno == EINTR) {
+				continue;
+			}
+			return -errno;
+		}
+		if (n == 0) {
+			return -ENOSPC;
+		}
+		done += (size_t)n;
+	}
+	return 0;
+}
+
+int co_storage_host_fsync(int fd)
+{
+	return fsync(fd) == 0 ? 0 : -errno;
+}
+
+void co_storage_host_close(int fd)
+{
+	(void)close(fd);
+}

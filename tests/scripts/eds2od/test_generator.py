@@ -1,0 +1,123 @@
+# Copyright (c) 2024 SafeLine contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Golden outputs, the data-type table, DCF handling and the generated layout."""
+
+import os
+import re
+import shutil
+
+import pytest
+
+from eds2od_testlib import BASE, DATA, GOLDEN, run_eds2od
+
+GOLDEN_CASES = [("alltypes.eds", "alltypes"), ("device.dcf", "device"), ("minimal.eds", "minimal")]
+
+
+@pytest.mark.parametrize("eds,name", GOLDEN_CASES)
+def test_golden_output(eds, name, tmp_path):
+    """Generated files equal the reviewed ones (UPDATE_GOLDEN=1 rewrites them)."""
+    out = tmp_path / "gen"
+    r = run_eds2od(os.path.join(DATA, eds), out, name)
+    assert r.returncode == 0, r.stderr
+    gdir = os.path.join(GOLDEN, name)
+    files = sorted(os.listdir(out))
+    assert files == sorted([f"{name}_od.c", f"{name}_od.h", f"{name}.eds"])
+    if os.environ.get("UPDATE_GOLDEN"):
+        shutil.rmtree(gdir, ignore_errors=True)
+        shutil.copytree(out, gdir)
+    for f in files:
+        with open(os.path.join(gdir, f), "rb") as g:
+            assert (out / f).read_bytes() == g.read(), f"{f} differs from {gdir}"
+
+
+def test_dtype_table_matches_types_h():
+    """The generator's type table is the X-macro table of include/canopen/types.h."""
+    from eds2od import dtypes
+
+    with open(os.path.join(BASE, "include", "canopen", "types.h")) as f:
+        text = f.read()
+    rows = re.findall(r"X\((\w+), (0x[0-9A-F]{4}), (\d+), (\w+), ([\w ]+)\)", text)
+    c_table = [(n, int(c, 16), int(s), k, t) for n, c, s, k, t in rows]
+    py_table = [(t.name, t.code, t.size, t.cls, t.ctype) for t in dtypes.TABLE]
+    assert c_table == py_table
+
+
+def test_dcf_values_and_commissioning(tmp_path):
+    out = tmp_path / "gen"
+    assert run_eds2od(os.path.join(DATA, "device.dcf"), out, "device").returncode == 0
+    h = (out / "device_od.h").read_text()
+    c = (out / "device_od.c").read_text()
+    assert "#define DEVICE_OD_NODE_ID 10U" in h
+    assert "#define DEVICE_OD_BITRATE_KBPS 500U" in h
+    # ParameterValue wins over DefaultValue; $NODEID uses the DCF node-ID in the template.
+    assert ".x1017_producer_heartbeat_time = 0xFAU" in c
+    assert ".cob_id_used_by_tpdo = 0x28AU" in c
+    assert "{0U, 0x1800U, 640}" not in c and re.search(r"\{\d+U, 0x1800U, 640\}", c)
+    assert ".x2000_setpoint = 0x5DCU" in c
+
+
+def test_dcf_compact_values(tmp_path):
+    out = tmp_path / "gen"
+    assert run_eds2od(os.path.join(DATA, "device.dcf"), out, "device").returncode == 0
+    c = (out / "device_od.c").read_text()
+    assert ".x2001_offsets = {.sub0 = 0x3U, .elem[0] = -5, .elem[1] = 0, .elem[2] = 7}" in c
+
+
+def test_storage_groups_and_rom(tmp_path):
+    out = tmp_path / "gen"
+    assert run_eds2od(os.path.join(DATA, "alltypes.eds"), out, "alltypes").returncode == 0
+    h = (out / "alltypes_od.h").read_text()
+    ram = h[h.index("struct alltypes_od_ram {"):h.index("struct alltypes_od_rom {")]
+    rom = h[h.index("struct alltypes_od_rom {"):]
+    groups = re.findall(r"^\t\} (\w+);$", ram, re.M)
+    assert groups == ["comm", "comm_vol", "manuf", "manuf_vol", "app"]
+
+    bodies = dict((g, b) for b, g in
+                  re.findall(r"^\tstruct \{\n(.*?)^\t\} (\w+);$", ram, re.M | re.S))
+
+    def group_of(field):
+        found = [g for g, b in bodies.items() if field in b]
+        return found[0] if len(found) == 1 else None
+
+    assert group_of("x1017_producer_heartbeat_time") == "comm"   # rw comm parameter
+    assert group_of("x1001_error_register") == "comm_vol"        # device-written
+    assert group_of("x1010_store_parameters") == "comm_vol"      # command object
+    assert group_of("x2003_integer_array") == "manuf"
+    assert group_of("x2005_volatile_counter") == "manuf_vol"
+    assert group_of("x6000_all_types") == "app"
+    assert "x1008_manufacturer_device_name" in rom               # const: flash
+    assert "x2004_const_real" in rom
+
+
+def test_name_defaults_to_file_name(tmp_path):
+    src = tmp_path / "My-Device.eds"
+    shutil.copy(os.path.join(DATA, "minimal.eds"), src)
+    r = run_eds2od(src, tmp_path / "gen")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "gen" / "my_device_od.h").exists()
+
+
+def test_cmake_module_declares_the_function():
+    with open(os.path.join(BASE, "cmake", "modules", "canopen_od.cmake")) as f:
+        text = f.read()
+    assert "function(canopen_od_generate target)" in text
+    assert "scripts/eds2od" in text
+
+
+def test_store_override(tmp_path):
+    """SafeLineStore=0 keeps a writable parameter out of its group, =1 puts one in."""
+    with open(os.path.join(DATA, "minimal.eds")) as f:
+        text = f.read()
+    text = text.replace("SupportedObjects=3\n1=0x1000", "SupportedObjects=3\n1=0x1000", 1)
+    text += ("\n[ManufacturerObjects]\nSupportedObjects=2\n1=0x2000\n2=0x2001\n\n"
+             "[2000]\nParameterName=Scratch\nDataType=0x0007\nAccessType=rw\nDefaultValue=0\n"
+             "SafeLineStore=0\n\n"
+             "[2001]\nParameterName=Kept\nDataType=0x0007\nAccessType=rw\nDefaultValue=0\n")
+    src = tmp_path / "store.eds"
+    src.write_text(text)
+    out = tmp_path / "gen"
+    r = run_eds2od(src, out, "store")
+    assert r.returncode == 0, r.stderr
+    h = (out / "store_od.h").read_text()
+    assert re.search(r"struct \{\n\t\tuint32_t x2001_kept;\n\t\} manuf;", h)
+    assert re.search(r"struct \{\n\t\tuint32_t x2000_scratch;\n\t\} manuf_vol;", h)
