@@ -7,6 +7,7 @@ which sets SAFELINE_IMAGE, SAFELINE_BUILD_DIR and SAFELINE_CAN_IFACES inside the
 
 import os
 import subprocess
+import threading
 import time
 
 import can
@@ -65,32 +66,44 @@ def bus_log(network):
 
 
 class Device:
+    """The image as a process; its output goes to image-<n>.log in the build folder."""
+
+    runs = 0
+
     def __init__(self, image, iface, network, eds, node_id=NODE_ID):
         self.node = canopen.RemoteNode(node_id, eds)
         network.add_node(self.node)
         self.cmd = [image, f"--can-if=0:{iface}", f"--node-id={node_id}"]
         self.proc = None
+        self.up = threading.Event()
+        Device.runs += 1
+        self.log_path = os.path.join(os.environ.get("SAFELINE_BUILD_DIR", "."),
+                                     f"image-{Device.runs}.log")
+
+    def _drain(self):
+        # Keep reading so the image never blocks on a full pipe.
+        with open(self.log_path, "w") as log:
+            for line in self.proc.stdout:
+                log.write(line)
+                log.flush()
+                if "hello_node: node" in line and "up on" in line:
+                    self.up.set()
 
     def start(self, wait_bootup=True):
         # Listen for the boot-up before the process exists, so it cannot be missed.
-        got = {"bootup": False}
+        got = threading.Event()
 
         def on_hb(state):
             if state == 0:
-                got["bootup"] = True
+                got.set()
 
         self.node.nmt.add_heartbeat_callback(on_hb)
         self.proc = subprocess.Popen(self.cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
-        line = self.proc.stdout.readline()
-        while line and "up on" not in line:
-            line = self.proc.stdout.readline()
-        assert "hello_node: node" in line, f"image did not come up: {line!r}"
+        threading.Thread(target=self._drain, daemon=True).start()
+        assert self.up.wait(10), f"image did not come up (see {self.log_path})"
         if wait_bootup:
-            end = time.monotonic() + 10
-            while not got["bootup"] and time.monotonic() < end:
-                time.sleep(0.01)
-            assert got["bootup"], "no boot-up message"
+            assert got.wait(10), "no boot-up message"
 
     def stop(self):
         if self.proc is not None and self.proc.poll() is None:

@@ -58,7 +58,11 @@ def test_reset_communication_sends_boot_up_again(dut, bus_log):
     dut.nmt.wait_for_heartbeat(3)
     bus_log.clear()
     dut.nmt.state = "RESET COMMUNICATION"
-    dut.nmt.wait_for_bootup(5)
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and not frames_with_id(bus_log, HB):
+        time.sleep(0.02)
+    own = frames_with_id(bus_log, HB)
+    assert own and own[0].data[0] == 0x00, "boot-up first after the reset"
     assert dut.nmt.wait_for_heartbeat(3) == "PRE-OPERATIONAL"
 
 

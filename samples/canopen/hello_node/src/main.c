@@ -103,6 +103,11 @@ static uint32_t data_read(const struct co_od_provider *p, const struct co_od_inf
 static uint32_t data_write(const struct co_od_provider *p, const struct co_od_info *info,
 			   uint32_t offset, const void *data, size_t len, bool last)
 {
+	if (data == NULL) {
+		/* The transfer was aborted: forget the shadow, keep the value. */
+		data_buf.shadow_len = 0U;
+		return 0;
+	}
 	if (offset == 0U) {
 		data_buf.shadow_len = 0U;
 	}
