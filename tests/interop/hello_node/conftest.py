@@ -15,6 +15,7 @@ import canopen
 import pytest
 
 NODE_ID = 0x10
+SDO_TIMEOUT = 3.0
 
 
 def _env(name):
@@ -72,6 +73,9 @@ class Device:
 
     def __init__(self, image, iface, network, eds, node_id=NODE_ID):
         self.node = canopen.RemoteNode(node_id, eds)
+        # python-canopen waits 0.3 s for an answer; inside the VM system calls are slow and a
+        # 127-segment sub-block can take longer than that to be acknowledged.
+        self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
         network.add_node(self.node)
         self.cmd = [image, f"--can-if=0:{iface}", f"--node-id={node_id}"]
         self.proc = None

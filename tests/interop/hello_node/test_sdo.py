@@ -11,7 +11,7 @@ import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 
-from conftest import NODE_ID
+from conftest import NODE_ID, SDO_TIMEOUT
 
 DATA = 0x2100  # DOMAIN, up to 128 KiB, provider-backed
 SDO_TX = 0x580 + NODE_ID
@@ -156,5 +156,5 @@ def test_sdo_is_silent_in_stopped(dut, bus_log):
         dut.sdo.upload(0x1000, 0)
     dut.nmt.state = "PRE-OPERATIONAL"
     dut.nmt.wait_for_heartbeat(3)
-    dut.sdo.RESPONSE_TIMEOUT = 1.0
+    dut.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
     assert struct.unpack("<I", dut.sdo.upload(0x1000, 0))[0] == 0
