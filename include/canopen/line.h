@@ -352,6 +352,16 @@ bool co_timer_is_armed(const struct co_timer *timer);
 int co_line_send(struct co_line *line, const struct can_frame *frame);
 
 /**
+ * @brief Free places in the line's TX queue.
+ *
+ * A producer of a long burst (an SDO block upload sub-block) checks this to pause before the
+ * queue overflows, instead of losing a frame to co_line_send()'s -ENOBUFS.
+ *
+ * @return Frames that can be sent now without an overflow (at least).
+ */
+int co_line_tx_space(struct co_line *line);
+
+/**
  * @brief Send a frame on behalf of a node attached to the line.
  *
  * Like co_line_send(); in addition, when several nodes share the line, the frame is delivered

@@ -541,6 +541,16 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 	return err;
 }
 
+int co_line_tx_space(struct co_line *line)
+{
+	int space;
+
+	k_mutex_lock(&line->tx_lock, K_FOREVER);
+	space = CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE - (int)line->tx_count;
+	k_mutex_unlock(&line->tx_lock);
+	return space;
+}
+
 void co_line_attach(struct co_line *line)
 {
 	k_mutex_lock(&line->lock, K_FOREVER);

@@ -593,7 +593,8 @@ static uint32_t blk_up_send(struct co_sdo_srv *srv, uint64_t now)
 		}
 		r[0] = i | (last ? CO_SDO_BLK_SEG_C : 0U);
 		memcpy(&r[1], &srv->buf[o - srv->buf_off], len);
-		err = srv_send(srv, r);
+		/* Pause before the line's TX queue overflows rather than lose a frame to it. */
+		err = co_line_tx_space(srv->node->line) > 0 ? srv_send(srv, r) : -ENOBUFS;
 		if (err == -ENOBUFS) {
 			/* The line's TX queue is full: offer the rest again shortly. */
 			srv->stats.tx_retries++;

@@ -781,6 +781,12 @@ ZTEST(sdo_block, test_block_upload_survives_tx_back_pressure)
 	}
 	h_expect_none();
 	zassert_true(h_stats(0).tx_retries > 0);
+	{
+		struct co_line_stats ls;
+
+		co_line_get_stats(&h.line, &ls);
+		zassert_equal(ls.tx_dropped, 0U, "the server paused before the queue overflowed");
+	}
 	h_req(0xA2, 29 | (127 << 8), 0, 0);
 	h_expect(0xC1 | (3 << 2), ref_crc16(data, 200), 0, 0);
 	h_req(0xA1, 0, 0, 0);
