@@ -104,7 +104,8 @@ class Device:
         self.node.nmt.add_heartbeat_callback(on_hb)
         self.proc = subprocess.Popen(self.cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
-        threading.Thread(target=self._drain, daemon=True).start()
+        self.drain = threading.Thread(target=self._drain, daemon=True)
+        self.drain.start()
         assert self.up.wait(10), f"image did not come up (see {self.log_path})"
         if wait_bootup:
             assert got.wait(10), "no boot-up message"
@@ -117,6 +118,9 @@ class Device:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        if self.proc is not None:
+            # The whole output, including what the image prints on its way out.
+            self.drain.join(timeout=10)
 
 
 @pytest.fixture

@@ -136,6 +136,22 @@ static const struct co_od_provider data_provider = {
 	.index_last = DATA_INDEX,
 };
 
+/* On the way out, the line's counters (tests read them to see back-pressure at work). */
+static void print_line_stats(void)
+{
+	struct co_line_stats st;
+
+	if (line.name == NULL) {
+		return;
+	}
+	co_line_get_stats(&line, &st);
+	printk("hello_node: line0 rx %u tx %u queued %u queue_max %u dropped %u errors %u "
+	       "overruns %u\n",
+	       st.rx_frames, st.tx_frames, st.tx_queued, st.tx_queue_max, st.tx_dropped,
+	       st.tx_errors, st.rx_overruns);
+}
+NATIVE_TASK(print_line_stats, ON_EXIT, 10);
+
 /* Line 0: SocketCAN when an interface was given, else the virtual bus. */
 static const struct device *line_device(void)
 {
