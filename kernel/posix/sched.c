@@ -118,8 +118,7 @@ static void waitq_add(_wait_q_t *wq, struct k_thread *thread)
 	struct k_thread *t;
 
 	/* Before the first thread of lower priority: FIFO among equal priorities. */
-	SYS_DLIST_FOR_EACH_CONTAINER(&wq->waitq, t, base.qnode_dlist)
-	{
+	SYS_DLIST_FOR_EACH_CONTAINER(&wq->waitq, t, base.qnode_dlist) {
 		if (z_is_prio_higher(thread->base.prio, t->base.prio)) {
 			sys_dlist_insert(&t->base.qnode_dlist, &thread->base.qnode_dlist);
 			thread->base.pended_on = wq;

@@ -98,21 +98,18 @@ int64_t z_timeout_deadline_ns(k_timeout_t timeout)
 	return z_now_ns() + z_ticks_to_ns(MAX(timeout.ticks, 0));
 }
 
+/* Ordering for the timeout list: true once past every timeout due at or before *data. */
+static int due_later(sys_dnode_t *node, void *data)
+{
+	return CONTAINER_OF(node, struct _timeout, node)->deadline_ns > *(int64_t *)data;
+}
+
 void z_add_timeout_at(struct _timeout *to, _timeout_func_t fn, int64_t deadline_ns)
 {
-	struct _timeout *t;
-
 	to->fn = fn;
 	to->deadline_ns = deadline_ns;
-	SYS_DLIST_FOR_EACH_CONTAINER(&timeout_list, t, node)
-	{
-		if (deadline_ns < t->deadline_ns) {
-			sys_dlist_insert(&t->node, &to->node);
-			goto inserted;
-		}
-	}
-	sys_dlist_append(&timeout_list, &to->node);
-inserted:
+	/* Behind timeouts with the same deadline: they expire in the order they were set. */
+	sys_dlist_insert_at(&timeout_list, &to->node, due_later, &deadline_ns);
 	if (sys_dlist_peek_head(&timeout_list) == &to->node) {
 		/* New earliest deadline: the timeout thread must sleep less. */
 		(void)pthread_cond_signal(&timeout_cond);

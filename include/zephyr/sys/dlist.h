@@ -215,8 +215,7 @@ static inline void sys_dlist_insert_at(sys_dlist_t *list, sys_dnode_t *node,
 {
 	sys_dnode_t *pos;
 
-	SYS_DLIST_FOR_EACH_NODE(list, pos)
-	{
+	SYS_DLIST_FOR_EACH_NODE(list, pos) {
 		if (cond(pos, data) != 0) {
 			sys_dlist_insert(pos, node);
 			return;
@@ -255,8 +254,7 @@ static inline size_t sys_dlist_len(const sys_dlist_t *list)
 	size_t len = 0;
 	sys_dnode_t *node;
 
-	SYS_DLIST_FOR_EACH_NODE(list, node)
-	{
+	SYS_DLIST_FOR_EACH_NODE(list, node) {
 		len++;
 	}
 

@@ -22,11 +22,15 @@ def test_golden_output(eds, name, tmp_path):
     gdir = os.path.join(GOLDEN, name)
     files = sorted(os.listdir(out))
     assert files == sorted([f"{name}_od.c", f"{name}_od.h", f"{name}.eds"])
+    # Stored as <file>.golden: expected output, not sources (no compiler or formatter
+    # should pick them up).
     if os.environ.get("UPDATE_GOLDEN"):
         shutil.rmtree(gdir, ignore_errors=True)
-        shutil.copytree(out, gdir)
+        os.makedirs(gdir)
+        for f in files:
+            shutil.copyfile(out / f, os.path.join(gdir, f + ".golden"))
     for f in files:
-        with open(os.path.join(gdir, f), "rb") as g:
+        with open(os.path.join(gdir, f + ".golden"), "rb") as g:
             assert (out / f).read_bytes() == g.read(), f"{f} differs from {gdir}"
 
 

@@ -47,8 +47,7 @@ static const char *dlist_str(sys_dlist_t *list)
 	struct item *it;
 	size_t n = 0;
 
-	SYS_DLIST_FOR_EACH_CONTAINER(list, it, dnode)
-	{
+	SYS_DLIST_FOR_EACH_CONTAINER(list, it, dnode) {
 		buf[n++] = (char)('0' + it->value);
 	}
 	buf[n] = '\0';
@@ -166,8 +165,7 @@ ZTEST(lists, test_slist_iterate_and_merge)
 
 	node = &items[1].snode;
 	sum = 0;
-	SYS_SLIST_ITERATE_FROM_NODE(&a, node)
-	{
+	SYS_SLIST_ITERATE_FROM_NODE(&a, node) {
 		sum += CONTAINER_OF(node, struct item, snode)->value;
 	}
 	zassert_equal(sum, 5, "iteration starts after the given node");
@@ -212,8 +210,7 @@ ZTEST(lists, test_dlist)
 	zassert_false(sys_dnode_is_linked(&items[1].dnode));
 	zassert_str_equal(dlist_str(&list), "023");
 
-	SYS_DLIST_FOR_EACH_NODE_SAFE(&list, node, next)
-	{
+	SYS_DLIST_FOR_EACH_NODE_SAFE(&list, node, next) {
 		sys_dlist_remove(node);
 	}
 	zassert_true(sys_dlist_is_empty(&list));
