@@ -109,6 +109,8 @@ struct co_sdo_srv {
 	struct co_sdo_srv_stats stats;
 	/* Protocol timeout: last client frame + CONFIG_CANOPEN_SDO_SERVER_TIMEOUT. */
 	uint64_t deadline;
+	/* Timeouts put off because our own frames had not left the line yet. */
+	uint8_t tx_waits;
 	/* Block download sub-block timeout (0 = not armed). */
 	uint64_t sub_deadline;
 	/* Retry of a sub-block the TX queue could not take (0 = none pending). */

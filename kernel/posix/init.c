@@ -56,8 +56,11 @@ void z_sys_init_run_level(int level)
 		} else {
 			rc = entry->init_fn.sys();
 		}
-		if (rc != 0) {
-			/* Zephyr carries on; saying so saves a debugging session. */
+		if (rc != 0 && entry->dev == NULL) {
+			/* Zephyr carries on; saying so saves a debugging session. A device that
+			 * fails is left not ready (device_is_ready()) and its driver logs why; an
+			 * unmapped SocketCAN controller, for one, is no error.
+			 */
 			printk("init: %s returned %d\n", entry->name, rc);
 		}
 	}

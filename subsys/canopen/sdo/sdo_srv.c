@@ -36,7 +36,9 @@
 
 LOG_MODULE_REGISTER(co_sdo_srv, CONFIG_CANOPEN_LOG_LEVEL);
 
-#define TIMEOUT_US ((uint64_t)CONFIG_CANOPEN_SDO_SERVER_TIMEOUT * 1000U)
+#define TIMEOUT_US   ((uint64_t)CONFIG_CANOPEN_SDO_SERVER_TIMEOUT * 1000U)
+/* How many times a timeout is put off while our own frames wait in the line's TX queue. */
+#define TX_WAITS_MAX 8U
 
 #if defined(CONFIG_CANOPEN_SDO_BLOCK)
 #define BLKSIZE        ((uint8_t)CONFIG_CANOPEN_SDO_BLOCK_MAX_BLKSIZE)
@@ -814,6 +816,7 @@ static void srv_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		srv_abort(srv, code);
 	} else if (srv->state != ST_IDLE) {
 		srv->deadline = now_us + TIMEOUT_US;
+		srv->tx_waits = 0U;
 		srv_arm(srv);
 	}
 	srv->in_rx = false;
@@ -832,6 +835,18 @@ static void srv_timer(struct co_timer *timer, uint64_t now_us)
 		return;
 	}
 	if (co_time_before_eq(srv->deadline, now_us)) {
+		/*
+		 * The client cannot answer frames that still wait in the line's TX queue (a
+		 * sub-block behind a slow controller): the timeout runs from when they can have
+		 * left. Bounded, so a queue that never drains still ends the transfer.
+		 */
+		if (co_line_tx_space(srv->node->line) < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE &&
+		    srv->tx_waits < TX_WAITS_MAX) {
+			srv->tx_waits++;
+			srv->deadline = now_us + TIMEOUT_US;
+			srv_arm(srv);
+			return;
+		}
 		srv_abort(srv, CO_SDO_AB_TIMEOUT);
 		return;
 	}

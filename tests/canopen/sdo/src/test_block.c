@@ -817,3 +817,45 @@ ZTEST(sdo_block, test_block_upload_send_error_ends_in_timeout)
 }
 
 #endif /* CONFIG_CANOPEN_SDO_BLOCK */
+
+ZTEST(sdo_block, test_timeout_waits_while_own_frames_are_queued)
+{
+	/* A controller that takes longer than the SDO timeout to send the sub-block: the client
+	 * cannot answer before it got the segments, so the server does not time out meanwhile.
+	 */
+	uint8_t d[8] = {0xA4, (uint8_t)RAMDOM, (uint8_t)(RAMDOM >> 8), 0, 127, 0};
+	const uint64_t timeout = CONFIG_CANOPEN_SDO_SERVER_TIMEOUT * MS;
+
+	set_ramdom(200, 26);
+	h_send(d);
+	h_expect(0xC6, RAMDOM, 0, 200);
+	h.sink_result = -EAGAIN;
+	h_req(0xA3, 0, 0, 0);
+	h_advance(3 * timeout);
+	zassert_equal(h_stats(0).aborts_sent, 0U, "no timeout while segments wait in the queue");
+	h.sink_result = 0;
+	h_advance(5 * MS);
+	for (uint8_t s = 1; s <= 29; s++) {
+		zassert_equal(h_next()->data[0], s == 29 ? 0x80 | s : s);
+	}
+	h_req(0xA2, 29 | (127 << 8), 0, 0);
+	h_expect(0xC1 | (3 << 2), ref_crc16(data, 200), 0, 0);
+	h_req(0xA1, 0, 0, 0);
+	zassert_equal(h_stats(0).completed, 1U);
+}
+
+ZTEST(sdo_block, test_timeout_comes_when_the_queue_never_drains)
+{
+	uint8_t d[8] = {0xA4, (uint8_t)RAMDOM, (uint8_t)(RAMDOM >> 8), 0, 127, 0};
+	const uint64_t timeout = CONFIG_CANOPEN_SDO_SERVER_TIMEOUT * MS;
+
+	set_ramdom(200, 27);
+	h_send(d);
+	h_expect(0xC6, RAMDOM, 0, 200);
+	h.sink_result = -EAGAIN;
+	h_req(0xA3, 0, 0, 0);
+	h_advance(20 * timeout);
+	zassert_equal(h_stats(0).aborts_sent, 1U, "the wait is bounded");
+	zassert_equal(h_stats(0).last_abort, CO_SDO_AB_TIMEOUT);
+	h.sink_result = 0;
+}
