@@ -13,6 +13,8 @@
 #include <zephyr/drivers/can.h>
 #include <zephyr/kernel.h>
 
+#include "can_filter_table.h"
+
 struct can_tx_sync_ctx {
 	struct k_sem done;
 	int status;
@@ -103,4 +105,49 @@ int can_add_rx_filter_msgq(const struct device *dev, struct k_msgq *msgq,
 	}
 
 	return can_add_rx_filter(dev, can_msgq_put, msgq, filter);
+}
+
+int can_filter_table_add(struct can_filter_slot *slots, int n, struct k_mutex *lock,
+			 can_rx_callback_t cb, void *user_data, const struct can_filter *filter)
+{
+	int id = -ENOSPC;
+
+	k_mutex_lock(lock, K_FOREVER);
+	for (int i = 0; i < n; i++) {
+		if (slots[i].cb == NULL) {
+			slots[i].cb = cb;
+			slots[i].user_data = user_data;
+			slots[i].filter = *filter;
+			id = i;
+			break;
+		}
+	}
+	k_mutex_unlock(lock);
+	return id;
+}
+
+void can_filter_table_remove(struct can_filter_slot *slots, int n, struct k_mutex *lock, int id)
+{
+	if (id < 0 || id >= n) {
+		return;
+	}
+	k_mutex_lock(lock, K_FOREVER);
+	slots[id].cb = NULL;
+	k_mutex_unlock(lock);
+}
+
+void can_filter_table_deliver(const struct device *dev, struct can_filter_slot *slots, int n,
+			      struct k_mutex *lock, const struct can_frame *frame)
+{
+	k_mutex_lock(lock, K_FOREVER);
+	for (int i = 0; i < n; i++) {
+		struct can_filter_slot *s = &slots[i];
+
+		if (s->cb != NULL && can_frame_matches_filter(frame, &s->filter)) {
+			struct can_frame copy = *frame;
+
+			s->cb(dev, &copy, s->user_data);
+		}
+	}
+	k_mutex_unlock(lock);
 }

@@ -29,6 +29,7 @@
 #include <zephyr/logging/log.h>
 #include <zephyr/sys/util.h>
 
+#include "can_filter_table.h"
 #include "can_socketcan.h"
 #include "cmdline.h"
 #include "posix_board_if.h"
@@ -46,12 +47,6 @@ LOG_MODULE_REGISTER(can_socketcan, CONFIG_CAN_LOG_LEVEL);
 #define SC_MAX_BITRATE 1000000U
 
 BUILD_ASSERT(SC_NUM_CTRL <= 8, "the driver defines up to 8 controllers");
-
-struct sc_filter {
-	can_rx_callback_t cb; /* NULL: free */
-	void *user_data;
-	struct can_filter filter;
-};
 
 struct sc_tx {
 	can_tx_callback_t cb;
@@ -81,7 +76,7 @@ struct sc_data {
 	struct k_sem echo_seen; /* given on every echo: room in the kernel queue again */
 	/* guarded by rx_lock */
 	struct k_mutex rx_lock;
-	struct sc_filter filters[SC_MAX_FILTERS];
+	struct can_filter_slot filters[SC_MAX_FILTERS];
 	struct k_thread rx_thread;
 };
 
@@ -221,17 +216,7 @@ static void sc_run_aborted(struct sc_data *d, const struct sc_tx *t, int n, int 
 
 static void sc_deliver(struct sc_data *d, const struct can_frame *frame)
 {
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	for (int i = 0; i < SC_MAX_FILTERS; i++) {
-		struct sc_filter *f = &d->filters[i];
-
-		if (f->cb != NULL && can_frame_matches_filter(frame, &f->filter)) {
-			struct can_frame copy = *frame;
-
-			f->cb(d->dev, &copy, f->user_data);
-		}
-	}
-	k_mutex_unlock(&d->rx_lock);
+	can_filter_table_deliver(d->dev, d->filters, SC_MAX_FILTERS, &d->rx_lock, frame);
 }
 
 static void sc_on_echo(struct sc_data *d, const struct can_frame *frame)
@@ -551,33 +536,16 @@ static int sc_add_rx_filter(const struct device *dev, can_rx_callback_t callback
 			    const struct can_filter *filter)
 {
 	struct sc_data *d = sc_data(dev);
-	int id = -ENOSPC;
 
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	for (int i = 0; i < SC_MAX_FILTERS; i++) {
-		if (d->filters[i].cb == NULL) {
-			d->filters[i].cb = callback;
-			d->filters[i].user_data = user_data;
-			d->filters[i].filter = *filter;
-			id = i;
-			break;
-		}
-	}
-	k_mutex_unlock(&d->rx_lock);
-
-	return id;
+	return can_filter_table_add(d->filters, SC_MAX_FILTERS, &d->rx_lock, callback, user_data,
+				    filter);
 }
 
 static void sc_remove_rx_filter(const struct device *dev, int filter_id)
 {
 	struct sc_data *d = sc_data(dev);
 
-	if (filter_id < 0 || filter_id >= SC_MAX_FILTERS) {
-		return;
-	}
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	d->filters[filter_id].cb = NULL;
-	k_mutex_unlock(&d->rx_lock);
+	can_filter_table_remove(d->filters, SC_MAX_FILTERS, &d->rx_lock, filter_id);
 }
 
 static int sc_get_state(const struct device *dev, enum can_state *state,

@@ -31,6 +31,7 @@
 #include <zephyr/logging/log.h>
 #include <zephyr/sys/util.h>
 
+#include "can_filter_table.h"
 #include "can_virtual.h"
 
 LOG_MODULE_REGISTER(can_virtual, CONFIG_CAN_LOG_LEVEL);
@@ -50,12 +51,6 @@ LOG_MODULE_REGISTER(can_virtual, CONFIG_CAN_LOG_LEVEL);
 	(CAN_MODE_LOOPBACK | CAN_MODE_LISTENONLY | CAN_MODE_ONE_SHOT | CAN_MODE_MANUAL_RECOVERY)
 
 BUILD_ASSERT(CV_NUM_CTRL <= 8, "the driver defines up to 8 controllers");
-
-struct cv_filter {
-	can_rx_callback_t cb; /* NULL: free */
-	void *user_data;
-	struct can_filter filter;
-};
 
 struct cv_tx {
 	bool used;
@@ -95,7 +90,7 @@ struct cv_data {
 	struct k_sem recovered;
 	/* guarded by rx_lock */
 	struct k_mutex rx_lock;
-	struct cv_filter filters[CV_MAX_FILTERS];
+	struct can_filter_slot filters[CV_MAX_FILTERS];
 };
 
 enum cv_fault_type {
@@ -304,18 +299,7 @@ static void cv_schedule_recovery_locked(struct cv_data *d)
 
 static void cv_deliver(struct cv_data *d, const struct can_frame *frame)
 {
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	for (int i = 0; i < CV_MAX_FILTERS; i++) {
-		struct cv_filter *f = &d->filters[i];
-
-		if (f->cb != NULL && can_frame_matches_filter(frame, &f->filter)) {
-			/* Each callback gets its own copy: it may modify it. */
-			struct can_frame copy = *frame;
-
-			f->cb(d->dev, &copy, f->user_data);
-		}
-	}
-	k_mutex_unlock(&d->rx_lock);
+	can_filter_table_deliver(d->dev, d->filters, CV_MAX_FILTERS, &d->rx_lock, frame);
 }
 
 static bool cv_can_receive_locked(const struct cv_data *d)
@@ -804,33 +788,16 @@ static int cv_add_rx_filter(const struct device *dev, can_rx_callback_t callback
 			    const struct can_filter *filter)
 {
 	struct cv_data *d = cv_data(dev);
-	int id = -ENOSPC;
 
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	for (int i = 0; i < CV_MAX_FILTERS; i++) {
-		if (d->filters[i].cb == NULL) {
-			d->filters[i].cb = callback;
-			d->filters[i].user_data = user_data;
-			d->filters[i].filter = *filter;
-			id = i;
-			break;
-		}
-	}
-	k_mutex_unlock(&d->rx_lock);
-
-	return id;
+	return can_filter_table_add(d->filters, CV_MAX_FILTERS, &d->rx_lock, callback, user_data,
+				    filter);
 }
 
 static void cv_remove_rx_filter(const struct device *dev, int filter_id)
 {
 	struct cv_data *d = cv_data(dev);
 
-	if (filter_id < 0 || filter_id >= CV_MAX_FILTERS) {
-		return;
-	}
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	d->filters[filter_id].cb = NULL;
-	k_mutex_unlock(&d->rx_lock);
+	can_filter_table_remove(d->filters, CV_MAX_FILTERS, &d->rx_lock, filter_id);
 }
 
 static int cv_get_state(const struct device *dev, enum can_state *state,
