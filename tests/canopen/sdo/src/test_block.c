@@ -816,7 +816,6 @@ ZTEST(sdo_block, test_block_upload_send_error_ends_in_timeout)
 	h_expect_abort(RAMDOM, 0, CO_SDO_AB_TIMEOUT);
 }
 
-#endif /* CONFIG_CANOPEN_SDO_BLOCK */
 
 ZTEST(sdo_block, test_timeout_waits_while_own_frames_are_queued)
 {
@@ -859,3 +858,5 @@ ZTEST(sdo_block, test_timeout_comes_when_the_queue_never_drains)
 	zassert_equal(h_stats(0).last_abort, CO_SDO_AB_TIMEOUT);
 	h.sink_result = 0;
 }
+
+#endif /* CONFIG_CANOPEN_SDO_BLOCK */
