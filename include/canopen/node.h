@@ -38,6 +38,12 @@
 #if defined(CONFIG_CANOPEN_SDO_SERVER) || defined(__DOXYGEN__)
 #include <canopen/sdo.h>
 #endif
+#if defined(CONFIG_CANOPEN_EMCY) || defined(__DOXYGEN__)
+#include <canopen/emcy.h>
+#endif
+#if defined(CONFIG_CANOPEN_SYNC) || defined(__DOXYGEN__)
+#include <canopen/sync.h>
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -59,6 +65,12 @@ struct co_node {
 	struct co_errctl ec;
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	struct co_sdo_srv sdo_srv[CONFIG_CANOPEN_SDO_SERVERS];
+#endif
+#if defined(CONFIG_CANOPEN_EMCY)
+	struct co_emcy emcy;
+#endif
+#if defined(CONFIG_CANOPEN_SYNC)
+	struct co_sync sync;
 #endif
 	/** @endcond */
 };

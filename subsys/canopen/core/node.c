@@ -44,6 +44,18 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
 	if (err != 0) {
 		return err;
 	}
+#if defined(CONFIG_CANOPEN_EMCY)
+	err = co_emcy_init(node);
+	if (err != 0) {
+		return err;
+	}
+#endif
+#if defined(CONFIG_CANOPEN_SYNC)
+	err = co_sync_init(node);
+	if (err != 0) {
+		return err;
+	}
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		err = co_sdo_srv_init(&node->sdo_srv[i], node, i);
@@ -73,6 +85,12 @@ int co_node_start(struct co_node *node)
 void co_node_services_reset_comm(struct co_node *node)
 {
 	co_errctl_reset_comm(node);
+#if defined(CONFIG_CANOPEN_EMCY)
+	co_emcy_reset_comm(node);
+#endif
+#if defined(CONFIG_CANOPEN_SYNC)
+	co_sync_reset_comm(node);
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		co_sdo_srv_reset_comm(&node->sdo_srv[i]);
@@ -83,6 +101,12 @@ void co_node_services_reset_comm(struct co_node *node)
 void co_node_services_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
 	co_errctl_set_state(node, from, to);
+#if defined(CONFIG_CANOPEN_EMCY)
+	co_emcy_set_state(node, to);
+#endif
+#if defined(CONFIG_CANOPEN_SYNC)
+	co_sync_set_state(node, to);
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		co_sdo_srv_set_state(&node->sdo_srv[i], to);

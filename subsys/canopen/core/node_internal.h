@@ -24,6 +24,29 @@ int co_errctl_init(struct co_node *node);
 void co_errctl_reset_comm(struct co_node *node);
 void co_errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to);
 
+#if defined(CONFIG_CANOPEN_EMCY)
+/* Emergency object (emcy/emcy.c). */
+int co_emcy_init(struct co_node *node);
+void co_emcy_reset_comm(struct co_node *node);
+void co_emcy_set_state(struct co_node *node, enum co_nmt_state to);
+/*
+ * A communication error of the stack itself (heartbeat or life guarding): @p event true when
+ * one just occurred (raises @p code unless active, then applies 1029h sub1), @p active whether
+ * any such error is still present (the code is cleared when none is).
+ */
+/* Another service's own error (e.g. SYNC length 8240h): raised once, cleared by the service. */
+void co_emcy_raise_internal(struct co_node *node, uint16_t code, uint8_t reg_bits);
+void co_emcy_clear_internal(struct co_node *node, uint16_t code);
+void co_emcy_comm_error(struct co_node *node, uint16_t code, uint8_t info, bool event, bool active);
+#endif
+
+#if defined(CONFIG_CANOPEN_SYNC)
+/* SYNC (sync/sync.c). */
+int co_sync_init(struct co_node *node);
+void co_sync_reset_comm(struct co_node *node);
+void co_sync_set_state(struct co_node *node, enum co_nmt_state to);
+#endif
+
 /* Every service, in the order the node configures them. */
 void co_node_services_reset_comm(struct co_node *node);
 void co_node_services_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to);

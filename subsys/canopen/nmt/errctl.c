@@ -68,6 +68,26 @@ static void send_state(struct co_node *node, uint8_t toggle)
 	(void)co_node_send(node, &f);
 }
 
+/*
+ * A heartbeat or life guarding event (@p event true) or its end: EMCY 8130h and the error
+ * behaviour 1029h sub1 (emcy/emcy.c). The code stays active while any monitor is lost.
+ */
+static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
+{
+#if defined(CONFIG_CANOPEN_EMCY)
+	bool active = node->ec.life_lost;
+
+	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
+		active = active || node->ec.hbc[i].mon == HB_LOST;
+	}
+	co_emcy_comm_error(node, CO_EMCY_HEARTBEAT, remote_id, event, active);
+#else
+	ARG_UNUSED(node);
+	ARG_UNUSED(remote_id);
+	ARG_UNUSED(event);
+#endif
+}
+
 /* --- Heartbeat producer ------------------------------------------------------------------- */
 
 static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
@@ -126,6 +146,7 @@ static void hbc_timeout(struct co_timer *timer, uint64_t now_us)
 		e->mon = HB_LOST;
 		LOG_WRN("%s: heartbeat of node %u lost", e->node->name, e->remote_id);
 		hbc_report(e, CO_HB_EV_LOST);
+		comm_error(e->node, e->remote_id, true);
 	}
 }
 
@@ -143,9 +164,14 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 	state = frame->data[0];
 	e->state = state;
 	if (state == (uint8_t)CO_NMT_INITIALISING) {
+		bool was_lost = e->mon == HB_LOST;
+
 		co_timer_stop(&e->timer);
 		e->mon = HB_IDLE;
 		hbc_report(e, CO_HB_EV_BOOTUP);
+		if (was_lost) {
+			comm_error(e->node, e->remote_id, false);
+		}
 		return;
 	}
 	co_timer_start(e->node->line, &e->timer, now_us + (uint64_t)e->time_ms * 1000U);
@@ -155,6 +181,7 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 	} else if (e->mon == HB_LOST) {
 		e->mon = HB_ACTIVE;
 		hbc_report(e, CO_HB_EV_RECOVERED);
+		comm_error(e->node, e->remote_id, false);
 	} else if (prev != state) {
 		hbc_report(e, CO_HB_EV_STATE);
 	}
@@ -171,10 +198,14 @@ static bool hbc_value_active(uint32_t v)
 static void hbc_configure(struct co_node *node, int i, uint32_t value)
 {
 	struct co_hb_entry *e = &node->ec.hbc[i];
+	bool was_lost = e->mon == HB_LOST;
 
 	co_rx_unregister(&e->rx);
 	co_timer_stop(&e->timer);
 	e->mon = HB_IDLE;
+	if (was_lost) {
+		comm_error(node, e->remote_id, false);
+	}
 	e->state = (uint8_t)CO_NMT_INITIALISING;
 	e->remote_id = 0U;
 	e->time_ms = 0U;
@@ -234,6 +265,7 @@ static void life_timeout(struct co_timer *timer, uint64_t now_us)
 	if (node->ec.life_ind != NULL) {
 		node->ec.life_ind(node, true, node->ec.life_user_data);
 	}
+	comm_error(node, 0U, true);
 }
 
 static void life_restart(struct co_node *node, uint64_t now_us)
@@ -265,6 +297,7 @@ static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t n
 		if (node->ec.life_ind != NULL) {
 			node->ec.life_ind(node, false, node->ec.life_user_data);
 		}
+		comm_error(node, 0U, false);
 	}
 }
 

@@ -1,0 +1,583 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * Emergency object (CiA 301 §7.2.7, objects §7.5.2): producer with its active-error table,
+ * error register 1001h, pre-defined error field 1003h, COB-ID 1014h and inhibit time 1015h;
+ * consumer 1028h; error behaviour 1029h for the stack's own communication errors.
+ *
+ * Decisions (doc/emcy.md):
+ * - Frames go out only in Pre-operational and Operational (CiA 301 Table 82). Errors raised in
+ *   Stopped are recorded (1001h, 1003h) but their frames are not sent, then or later; entering
+ *   Stopped drops frames still waiting for the inhibit time.
+ * - Every clear sends an error reset (0000h) with the remaining 1001h (CiA 301 §7.2.7.2,
+ *   transitions 3 and 5); after the last clear 1001h is 0.
+ * - 1003h manufacturer info (bits 31..16) is msef[0..1], little endian.
+ * - Reset Communication reloads 1001h and 1003h from the dictionary; errors raised by the
+ *   application stay active (their bits are put back into 1001h), the stack's own
+ *   communication errors are dropped (monitoring starts afresh).
+ */
+
+#include <errno.h>
+#include <string.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/emcy.h>
+#include <canopen/node.h>
+
+#include "node_internal.h"
+
+LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
+
+#define IDX_ERR_REG   0x1001U
+#define IDX_ERR_FIELD 0x1003U
+#define IDX_COB_ID    0x1014U
+#define IDX_INHIBIT   0x1015U
+#define IDX_CONSUMER  0x1028U
+#define IDX_BEHAVIOUR 0x1029U
+
+#define COB_INVALID BIT(31)
+#define COB_EXT     BIT(29)
+
+/* 1029h values (CiA 301 §7.5.2.33). */
+#define BEH_PRE_OPERATIONAL 0U
+#define BEH_NO_CHANGE       1U
+#define BEH_STOPPED         2U
+
+static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint64_t dflt)
+{
+	uint8_t buf[8] = {0};
+	size_t len = 0;
+
+	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
+		return dflt;
+	}
+	return co_od_le_get(buf, len);
+}
+
+static void od_put(struct co_node *node, uint16_t index, uint8_t sub, uint64_t v, size_t len)
+{
+	uint8_t buf[8];
+
+	co_od_le_put(buf, len, v);
+	node->emcy.self_write = true;
+	(void)co_od_write(&node->od, index, sub, buf, len, CO_OD_WRITER_APP);
+	node->emcy.self_write = false;
+}
+
+/* 1001h from the active errors, plus the bits of errors that did not fit the table. */
+static void update_reg(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+	uint8_t reg = em->lost_reg;
+
+	for (int i = 0; i < em->n_active; i++) {
+		reg |= em->active[i].reg;
+	}
+	/* Bit 0 (generic) is set whenever any error is present. */
+	if (reg != 0U || em->n_active != 0U) {
+		reg |= CO_EMCY_REG_GENERIC;
+	}
+	em->reg = reg;
+	od_put(node, IDX_ERR_REG, 0, reg, 1U);
+}
+
+/* --- Frames and the inhibit time ---------------------------------------------------------- */
+
+static uint64_t inhibit_us(const struct co_emcy *em)
+{
+	return (uint64_t)em->inhibit_100us * 100U;
+}
+
+static void transmit(struct co_node *node, const uint8_t data[8], uint64_t now_us)
+{
+	struct can_frame f = {
+		.id = node->emcy.cob_id & 0x7ffU,
+		.dlc = 8U,
+	};
+
+	memcpy(f.data, data, 8);
+	(void)co_node_send(node, &f);
+	node->emcy.last_tx_us = now_us;
+	node->emcy.sent_any = true;
+}
+
+static bool producer_on(const struct co_emcy *em)
+{
+	return em->enabled && (em->cob_id & COB_INVALID) == 0U;
+}
+
+static void arm_inhibit(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+
+	if (em->q_count != 0U) {
+		co_timer_start(node->line, &em->inhibit_timer, em->last_tx_us + inhibit_us(em));
+	} else {
+		co_timer_stop(&em->inhibit_timer);
+	}
+}
+
+static void inhibit_expired(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_node *node = timer->user_data;
+	struct co_emcy *em = &node->emcy;
+
+	if (em->q_count == 0U || !producer_on(em)) {
+		return;
+	}
+	transmit(node, em->queue[em->q_head], now_us);
+	em->q_head = (uint8_t)((em->q_head + 1U) % CONFIG_CANOPEN_EMCY_QUEUE);
+	em->q_count--;
+	arm_inhibit(node);
+}
+
+static void flush_queue(struct co_emcy *em)
+{
+	co_timer_stop(&em->inhibit_timer);
+	em->q_head = 0U;
+	em->q_count = 0U;
+}
+
+static void emit(struct co_node *node, uint16_t code, uint8_t reg, const uint8_t msef[5])
+{
+	struct co_emcy *em = &node->emcy;
+	uint64_t now = co_line_time(node->line);
+	uint8_t data[8] = {(uint8_t)code, (uint8_t)(code >> 8), reg};
+
+	if (!producer_on(em)) {
+		return;
+	}
+	if (msef != NULL) {
+		memcpy(&data[3], msef, 5);
+	}
+	if (em->q_count == 0U && (!em->sent_any || em->inhibit_100us == 0U ||
+				  co_time_before_eq(em->last_tx_us + inhibit_us(em), now))) {
+		transmit(node, data, now);
+		return;
+	}
+	if (em->q_count == CONFIG_CANOPEN_EMCY_QUEUE) {
+		em->overflows++;
+		LOG_WRN("%s: EMCY %04x lost, inhibit queue full", node->name, code);
+		return;
+	}
+	memcpy(em->queue[(em->q_head + em->q_count) % CONFIG_CANOPEN_EMCY_QUEUE], data, 8);
+	em->q_count++;
+	arm_inhibit(node);
+}
+
+/* --- Pre-defined error field 1003h -------------------------------------------------------- */
+
+static void history_push(struct co_node *node, uint32_t entry)
+{
+	uint8_t max = node->emcy.hist_max;
+	uint8_t count;
+
+	if (max == 0U) {
+		return;
+	}
+	count = (uint8_t)od_uint(node, IDX_ERR_FIELD, 0, 0U);
+	if (count > max) {
+		count = max;
+	}
+	/* Newest at sub1; the oldest drops off when full. */
+	for (uint8_t s = (count < max) ? count + 1U : max; s > 1U; s--) {
+		od_put(node, IDX_ERR_FIELD, s, od_uint(node, IDX_ERR_FIELD, s - 1U, 0U), 4U);
+	}
+	od_put(node, IDX_ERR_FIELD, 1, entry, 4U);
+	od_put(node, IDX_ERR_FIELD, 0, count < max ? count + 1U : max, 1U);
+}
+
+static uint32_t history_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	if (node->emcy.self_write || req->writer == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	/* CiA 301 §7.5.2.3: only 0 may be written to sub0, and it clears the list. */
+	if (req->info->sub != 0U || co_od_req_uint(req) != 0U) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	return 0U;
+}
+
+static void history_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	if (node->emcy.self_write || req->info->sub != 0U) {
+		return;
+	}
+	for (uint8_t s = 1U; s <= node->emcy.hist_max; s++) {
+		od_put(node, IDX_ERR_FIELD, s, 0U, 4U);
+	}
+}
+
+static uint32_t reg_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	/* 1001h follows the active errors; only this module writes it. */
+	return node->emcy.self_write ? 0U : CO_SDO_AB_READONLY;
+}
+
+/* --- 1014h, 1015h ------------------------------------------------------------------------- */
+
+/* CiA 301 §7.3.5: identifiers reserved for other services. */
+static bool cob_restricted(uint32_t id)
+{
+	return id == 0x000U || (id >= 0x001U && id <= 0x07fU) || (id >= 0x101U && id <= 0x180U) ||
+	       (id >= 0x581U && id <= 0x5ffU) || (id >= 0x601U && id <= 0x67fU) ||
+	       (id >= 0x6e0U && id <= 0x6ffU) || (id >= 0x701U && id <= 0x7ffU);
+}
+
+static uint32_t cob_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint32_t v = (uint32_t)co_od_req_uint(req);
+	uint32_t old = node->emcy.cob_id;
+
+	if (req->writer == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	/* 29-bit identifiers are not supported: only 11-bit COB-IDs are served. */
+	if ((v & COB_EXT) != 0U || (v & 0x1ffff800U) != 0U) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	if ((v & COB_INVALID) != 0U) {
+		return 0U;
+	}
+	/* The CAN-ID may only change while the object is invalid (CiA 301 §7.5.2.15). */
+	if ((old & COB_INVALID) == 0U && (old & 0x7ffU) != (v & 0x7ffU)) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	if (cob_restricted(v & 0x7ffU)) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	return 0U;
+}
+
+static void cob_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	node->emcy.cob_id = (uint32_t)co_od_req_uint(req);
+	if ((node->emcy.cob_id & COB_INVALID) != 0U) {
+		flush_queue(&node->emcy);
+	}
+}
+
+static void inhibit_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	node->emcy.inhibit_100us = (uint16_t)co_od_req_uint(req);
+	/* Frames already waiting are due at the new inhibit time after the last one. */
+	arm_inhibit(node);
+}
+
+/* --- Consumer 1028h ----------------------------------------------------------------------- */
+
+static void cons_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_node *node = rx->user_data;
+	struct co_emcy *em = &node->emcy;
+	uint16_t id = (uint16_t)frame->id;
+	uint8_t remote = 0U;
+
+	/* An EMCY is always 8 bytes (CiA 301 §7.2.7.3.1). */
+	if (frame->dlc != 8U || (frame->flags & CAN_FRAME_RTR) != 0U || !em->enabled ||
+	    em->ind == NULL) {
+		return;
+	}
+	if (id > CO_EMCY_COB_ID && id <= CO_EMCY_COB_ID + 127U) {
+		remote = (uint8_t)(id - CO_EMCY_COB_ID);
+	}
+	em->ind(node, id, remote, (uint16_t)(frame->data[0] | (frame->data[1] << 8)),
+		frame->data[2], &frame->data[3], em->ind_user_data);
+}
+
+static void cons_configure(struct co_node *node, int i, uint32_t v)
+{
+	struct co_rx *rx = &node->emcy.cons_rx[i];
+
+	co_rx_unregister(rx);
+	if ((v & (COB_INVALID | COB_EXT)) != 0U || (v & 0x7ffU) == 0U) {
+		return;
+	}
+	rx->id = v & 0x7ffU;
+	if (co_rx_register(node->line, rx) != 0) {
+		LOG_ERR("%s: no receive slot for EMCY consumer %03x", node->name, rx->id);
+	}
+}
+
+static void cons_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint8_t sub = req->info->sub;
+
+	if (sub >= 1U && sub <= CONFIG_CANOPEN_EMCY_CONSUMERS) {
+		cons_configure(node, sub - 1, (uint32_t)co_od_req_uint(req));
+	}
+}
+
+/* --- Active errors ------------------------------------------------------------------------ */
+
+static int find_active(const struct co_emcy *em, uint16_t code)
+{
+	for (int i = 0; i < em->n_active; i++) {
+		if (em->active[i].code == code) {
+			return i;
+		}
+	}
+	return -1;
+}
+
+static int raise_locked(struct co_node *node, uint16_t code, uint8_t reg_bits,
+			const uint8_t msef[5], bool internal)
+{
+	struct co_emcy *em = &node->emcy;
+	int i = find_active(em, code);
+	uint32_t info = (msef != NULL) ? (uint32_t)(msef[0] | (msef[1] << 8)) : 0U;
+	int err = 0;
+
+	reg_bits |= CO_EMCY_REG_GENERIC;
+	if (i >= 0) {
+		em->active[i].reg |= reg_bits;
+	} else if (em->n_active < CONFIG_CANOPEN_EMCY_ACTIVE_ERRORS) {
+		em->active[em->n_active++] = (struct co_emcy_active){
+			.code = code, .reg = reg_bits, .internal = internal};
+	} else {
+		/* No slot: its bits stay until the last clear. */
+		em->lost_reg |= reg_bits;
+		err = -ENOSPC;
+	}
+	update_reg(node);
+	history_push(node, code | (info << 16));
+	emit(node, code, em->reg, msef);
+	return err;
+}
+
+static int clear_locked(struct co_node *node, uint16_t code)
+{
+	struct co_emcy *em = &node->emcy;
+	int i = find_active(em, code);
+
+	if (i < 0) {
+		return -ENOENT;
+	}
+	em->active[i] = em->active[--em->n_active];
+	if (em->n_active == 0U) {
+		em->lost_reg = 0U;
+	}
+	update_reg(node);
+	emit(node, CO_EMCY_NO_ERROR, em->reg, NULL);
+	return 0;
+}
+
+/* --- 1029h and the stack's communication errors ------------------------------------------- */
+
+static void error_behaviour(struct co_node *node, uint8_t sub)
+{
+	/* An absent 1029h behaves as its default, 0 (Pre-operational). */
+	uint8_t beh = (uint8_t)od_uint(node, IDX_BEHAVIOUR, sub, BEH_PRE_OPERATIONAL);
+
+	switch (beh) {
+	case BEH_PRE_OPERATIONAL:
+		if (node->nmt.state == CO_NMT_OPERATIONAL) {
+			(void)co_nmt_req(node, CO_NMT_CS_ENTER_PRE_OPERATIONAL);
+		}
+		break;
+	case BEH_STOPPED:
+		(void)co_nmt_req(node, CO_NMT_CS_STOP);
+		break;
+	default:
+		/* 1 = no change; reserved and manufacturer values change nothing either. */
+		break;
+	}
+}
+
+void co_emcy_comm_error(struct co_node *node, uint16_t code, uint8_t info, bool event, bool active)
+{
+	uint8_t msef[5] = {info};
+
+	if (event) {
+		if (find_active(&node->emcy, code) < 0) {
+			(void)raise_locked(node, code, CO_EMCY_REG_COMMUNICATION, msef, true);
+		}
+		error_behaviour(node, 1U);
+	} else if (!active) {
+		(void)clear_locked(node, code);
+	}
+}
+
+void co_emcy_raise_internal(struct co_node *node, uint16_t code, uint8_t reg_bits)
+{
+	if (find_active(&node->emcy, code) < 0) {
+		(void)raise_locked(node, code, reg_bits, NULL, true);
+	}
+}
+
+void co_emcy_clear_internal(struct co_node *node, uint16_t code)
+{
+	(void)clear_locked(node, code);
+}
+
+/* --- Node interface ----------------------------------------------------------------------- */
+
+int co_emcy_init(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+	const struct co_od_hook hooks[] = {
+		{IDX_ERR_REG, IDX_ERR_REG, 0, 0, reg_validate, NULL, node},
+		{IDX_ERR_FIELD, IDX_ERR_FIELD, 0, 254, history_validate, history_notify, node},
+		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
+		{IDX_INHIBIT, IDX_INHIBIT, 0, 0, NULL, inhibit_notify, node},
+		{IDX_CONSUMER, IDX_CONSUMER, 1, 127, NULL, cons_notify, node},
+	};
+
+	co_timer_init(&em->inhibit_timer, inhibit_expired, &node->lock, node);
+	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
+		struct co_rx *rx = &em->cons_rx[i];
+
+		rx->mask = 0x7ffU;
+		rx->handler = cons_rx;
+		rx->lock = &node->lock;
+		rx->user_data = node;
+	}
+	em->cob_id = COB_INVALID;
+	for (size_t i = 0; i < ARRAY_SIZE(hooks); i++) {
+		int err = co_od_hook_register(&node->od, &hooks[i]);
+
+		if (err != 0) {
+			return err;
+		}
+	}
+	return 0;
+}
+
+void co_emcy_reset_comm(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+	struct co_od_info info;
+	uint8_t n = 0U;
+	uint8_t count;
+
+	flush_queue(em);
+	em->overflows = 0U;
+	em->sent_any = false;
+	/* Without 1014h there is no EMCY producer. */
+	em->cob_id = (uint32_t)od_uint(node, IDX_COB_ID, 0, COB_INVALID);
+	em->inhibit_100us = (uint16_t)od_uint(node, IDX_INHIBIT, 0, 0U);
+
+	/* 1003h entries served: the dictionary's array, at most CONFIG_CANOPEN_EMCY_HISTORY. */
+	while (n < CONFIG_CANOPEN_EMCY_HISTORY &&
+	       co_od_find(&node->od, IDX_ERR_FIELD, (uint8_t)(n + 1U), &info) == 0U) {
+		n++;
+	}
+	em->hist_max = n;
+
+	/* The stack's own errors restart with monitoring; the application's stay. */
+	for (int i = 0; i < em->n_active;) {
+		if (em->active[i].internal) {
+			em->active[i] = em->active[--em->n_active];
+		} else {
+			i++;
+		}
+	}
+	update_reg(node);
+
+	count = (uint8_t)od_uint(node, IDX_CONSUMER, 0, 0U);
+	if (count > CONFIG_CANOPEN_EMCY_CONSUMERS) {
+		LOG_WRN("%s: 1028h has %u entries, CONFIG_CANOPEN_EMCY_CONSUMERS=%d are served",
+			node->name, count, CONFIG_CANOPEN_EMCY_CONSUMERS);
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
+		uint32_t v = i < count ? (uint32_t)od_uint(node, IDX_CONSUMER, (uint8_t)(i + 1),
+							   COB_INVALID)
+				       : COB_INVALID;
+
+		cons_configure(node, i, v);
+	}
+}
+
+void co_emcy_set_state(struct co_node *node, enum co_nmt_state to)
+{
+	struct co_emcy *em = &node->emcy;
+
+	/* CiA 301 Table 82: EMCY in Pre-operational and Operational only. */
+	em->enabled = to == CO_NMT_PRE_OPERATIONAL || to == CO_NMT_OPERATIONAL;
+	if (!em->enabled) {
+		flush_queue(em);
+	}
+}
+
+/* --- API ---------------------------------------------------------------------------------- */
+
+int co_emcy_raise(struct co_node *node, uint16_t code, uint8_t reg_bits, const uint8_t msef[5])
+{
+	int err;
+
+	if (node == NULL || code == CO_EMCY_NO_ERROR) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	err = raise_locked(node, code, reg_bits, msef, false);
+	co_node_unlock(node);
+	return err;
+}
+
+int co_emcy_clear(struct co_node *node, uint16_t code)
+{
+	int err;
+
+	if (node == NULL) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	err = clear_locked(node, code);
+	co_node_unlock(node);
+	return err;
+}
+
+bool co_emcy_is_active(struct co_node *node, uint16_t code)
+{
+	bool active;
+
+	co_node_lock(node);
+	active = find_active(&node->emcy, code) >= 0;
+	co_node_unlock(node);
+	return active;
+}
+
+uint8_t co_emcy_get_reg(struct co_node *node)
+{
+	uint8_t reg;
+
+	co_node_lock(node);
+	reg = node->emcy.reg;
+	co_node_unlock(node);
+	return reg;
+}
+
+void co_emcy_get_status(struct co_node *node, struct co_emcy_status *status)
+{
+	co_node_lock(node);
+	status->active = node->emcy.n_active;
+	status->queued = node->emcy.q_count;
+	status->overflows = node->emcy.overflows;
+	co_node_unlock(node);
+}
+
+void co_emcy_set_ind(struct co_node *node, co_emcy_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->emcy.ind = cb;
+	node->emcy.ind_user_data = user_data;
+	co_node_unlock(node);
+}
