@@ -280,6 +280,22 @@ void co_line_set_event_cb(struct co_line *line, co_line_event_cb_t cb, void *use
  */
 
 /**
+ * @brief Fill a receiver for one exact 11-bit COB-ID; register it with co_rx_register() or
+ * co_rx_set_id().
+ */
+static inline void co_rx_init(struct co_rx *rx, uint32_t id, co_rx_handler_t handler,
+			      struct k_mutex *lock, void *user_data)
+{
+	*rx = (struct co_rx){
+		.id = id,
+		.mask = 0x7ffU,
+		.handler = handler,
+		.lock = lock,
+		.user_data = user_data,
+	};
+}
+
+/**
  * @brief Register a receiver on a line.
  *
  * Fill @p rx (id, mask, ext, handler, lock, user_data) first. Several receivers may share one

@@ -439,6 +439,13 @@ int co_od_set_restore_cb(struct co_od *od, co_od_restore_cb cb, void *user_data)
 int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook);
 
 /**
+ * @brief Register @p n hooks (a service's table of hooks on its objects).
+ * @retval 0 success
+ * @retval -EINVAL or -ENOSPC as co_od_hook_register(), for the first hook that failed
+ */
+int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n);
+
+/**
  * @brief Remove every hook registered with @p user_data.
  *
  * @return the number of hooks removed

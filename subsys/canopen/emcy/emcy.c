@@ -443,22 +443,10 @@ int co_emcy_init(struct co_node *node)
 
 	co_timer_init(&em->inhibit_timer, inhibit_expired, &node->lock, node);
 	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
-		struct co_rx *rx = &em->cons_rx[i];
-
-		rx->mask = 0x7ffU;
-		rx->handler = cons_rx;
-		rx->lock = &node->lock;
-		rx->user_data = node;
+		co_rx_init(&em->cons_rx[i], 0U, cons_rx, &node->lock, node);
 	}
 	em->cob_id = COB_INVALID;
-	for (size_t i = 0; i < ARRAY_SIZE(hooks); i++) {
-		int err = co_od_hook_register(&node->od, &hooks[i]);
-
-		if (err != 0) {
-			return err;
-		}
-	}
-	return 0;
+	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
 void co_emcy_reset_comm(struct co_node *node)

@@ -330,25 +330,12 @@ int co_errctl_init(struct co_node *node)
 		struct co_hb_entry *e = &ec->hbc[i];
 
 		e->node = node;
-		e->rx.mask = 0x7ffU;
-		e->rx.handler = hbc_rx;
-		e->rx.lock = &node->lock;
-		e->rx.user_data = e;
+		co_rx_init(&e->rx, 0U, hbc_rx, &node->lock, e);
 		co_timer_init(&e->timer, hbc_timeout, &node->lock, e);
 	}
-	ec->guard_rx.mask = 0x7ffU;
-	ec->guard_rx.handler = guard_rx;
-	ec->guard_rx.lock = &node->lock;
-	ec->guard_rx.user_data = node;
+	co_rx_init(&ec->guard_rx, 0U, guard_rx, &node->lock, node);
 
-	for (size_t i = 0; i < ARRAY_SIZE(hooks); i++) {
-		int err = co_od_hook_register(&node->od, &hooks[i]);
-
-		if (err != 0) {
-			return err;
-		}
-	}
-	return 0;
+	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
 void co_errctl_reset_comm(struct co_node *node)

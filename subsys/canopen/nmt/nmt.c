@@ -152,15 +152,8 @@ static void nmt_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 
 void co_nmt_init(struct co_node *node)
 {
-	struct co_rx *rx = &node->nmt_rx;
-
-	rx->id = CO_NMT_COB_ID;
-	rx->mask = 0x7ffU;
-	rx->ext = false;
-	rx->handler = nmt_rx;
-	rx->lock = &node->lock;
-	rx->user_data = node;
-	(void)co_rx_register(node->line, rx);
+	co_rx_init(&node->nmt_rx, CO_NMT_COB_ID, nmt_rx, &node->lock, node);
+	(void)co_rx_register(node->line, &node->nmt_rx);
 }
 
 enum co_nmt_state co_nmt_get_state(struct co_node *node)

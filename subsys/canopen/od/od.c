@@ -486,6 +486,18 @@ void co_od_reset_app(struct co_od *od)
 /* ---------------------------------------------------------------------------------------- */
 /* Hooks and providers */
 
+int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		int err = co_od_hook_register(od, &hooks[i]);
+
+		if (err != 0) {
+			return err;
+		}
+	}
+	return 0;
+}
+
 int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 {
 	if (od == NULL || hook == NULL || hook->index_last < hook->index_first ||

@@ -219,18 +219,8 @@ int co_sync_init(struct co_node *node)
 	};
 
 	co_timer_init(&s->timer, timer_handler, &node->lock, node);
-	s->rx.mask = 0x7ffU;
-	s->rx.handler = sync_rx;
-	s->rx.lock = &node->lock;
-	s->rx.user_data = node;
-	for (size_t i = 0; i < ARRAY_SIZE(hooks); i++) {
-		int err = co_od_hook_register(&node->od, &hooks[i]);
-
-		if (err != 0) {
-			return err;
-		}
-	}
-	return 0;
+	co_rx_init(&s->rx, 0U, sync_rx, &node->lock, node);
+	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
 void co_sync_reset_comm(struct co_node *node)

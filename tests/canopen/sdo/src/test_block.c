@@ -816,7 +816,6 @@ ZTEST(sdo_block, test_block_upload_send_error_ends_in_timeout)
 	h_expect_abort(RAMDOM, 0, CO_SDO_AB_TIMEOUT);
 }
 
-
 ZTEST(sdo_block, test_timeout_waits_while_own_frames_are_queued)
 {
 	/* A controller that takes longer than the SDO timeout to send the sub-block: the client
