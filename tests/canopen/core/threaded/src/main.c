@@ -245,3 +245,29 @@ ZTEST(co_threaded, test_application_threads_and_line_threads_share_nodes)
 	zassert_true(wait_until(neighbour_heard_again), "heartbeat after the reset (1017h 1 s)");
 	configure(0, 0);
 }
+
+static bool queue_empty(void)
+{
+	return co_line_tx_space(&lines[1]) == CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE;
+}
+
+ZTEST(co_threaded, test_frames_sent_while_the_line_is_stopped_go_out_at_start)
+{
+	struct can_frame f = {.id = 0x555, .dlc = 1, .data = {0x42}};
+	struct co_line_stats before, after;
+
+	zassert_ok(co_line_stop(&lines[1]));
+	co_line_get_stats(&lines[1], &before);
+	zassert_ok(co_line_send(&lines[1], &f), "queued, not an error");
+	zassert_true(co_line_tx_space(&lines[1]) < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+	zassert_ok(co_line_start(&lines[1], stacks[1], K_THREAD_STACK_SIZEOF(stacks[1]),
+				 CONFIG_CANOPEN_LINE_THREAD_PRIORITY));
+	for (int i = 0; i < 100 && !queue_empty(); i++) {
+		k_msleep(10);
+	}
+	zassert_true(queue_empty(), "the queue drains once the line runs");
+	co_line_get_stats(&lines[1], &after);
+	zassert_equal(after.tx_errors, before.tx_errors, "nothing refused with -ENETDOWN");
+	zassert_equal(after.tx_dropped, before.tx_dropped);
+	zassert_true(after.tx_frames > before.tx_frames);
+}
