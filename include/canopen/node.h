@@ -44,6 +44,18 @@
 #if defined(CONFIG_CANOPEN_SYNC) || defined(__DOXYGEN__)
 #include <canopen/sync.h>
 #endif
+#if defined(CONFIG_CANOPEN_TIME) || defined(__DOXYGEN__)
+#include <canopen/time.h>
+#endif
+#if defined(CONFIG_CANOPEN_PDO) || defined(__DOXYGEN__)
+#include <canopen/pdo.h>
+#endif
+#if defined(CONFIG_CANOPEN_SDO_CLIENT) || defined(__DOXYGEN__)
+#include <canopen/sdo_cli.h>
+#endif
+#if defined(CONFIG_CANOPEN_MGR) || defined(__DOXYGEN__)
+#include <canopen/mgr.h>
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -71,6 +83,18 @@ struct co_node {
 #endif
 #if defined(CONFIG_CANOPEN_SYNC)
 	struct co_sync sync;
+#endif
+#if defined(CONFIG_CANOPEN_TIME)
+	struct co_time time;
+#endif
+#if defined(CONFIG_CANOPEN_PDO)
+	struct co_pdo pdo;
+#endif
+#if defined(CONFIG_CANOPEN_SDO_CLIENT)
+	struct co_sdo_cli sdo_cli[CONFIG_CANOPEN_SDO_CLIENTS];
+#endif
+#if defined(CONFIG_CANOPEN_MGR)
+	struct co_mgr mgr;
 #endif
 	/** @endcond */
 };

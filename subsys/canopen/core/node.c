@@ -56,12 +56,38 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
 		return err;
 	}
 #endif
+#if defined(CONFIG_CANOPEN_TIME)
+	err = co_time_init(node);
+	if (err != 0) {
+		return err;
+	}
+#endif
+#if defined(CONFIG_CANOPEN_PDO)
+	err = co_pdo_init(node);
+	if (err != 0) {
+		return err;
+	}
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		err = co_sdo_srv_init(&node->sdo_srv[i], node, i);
 		if (err != 0) {
 			return err;
 		}
+	}
+#endif
+#if defined(CONFIG_CANOPEN_SDO_CLIENT)
+	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		err = co_sdo_cli_init(&node->sdo_cli[i], node, i);
+		if (err != 0) {
+			return err;
+		}
+	}
+#endif
+#if defined(CONFIG_CANOPEN_MGR)
+	err = co_mgr_init(node);
+	if (err != 0) {
+		return err;
 	}
 #endif
 	return 0;
@@ -91,10 +117,24 @@ void co_node_services_reset_comm(struct co_node *node)
 #if defined(CONFIG_CANOPEN_SYNC)
 	co_sync_reset_comm(node);
 #endif
+#if defined(CONFIG_CANOPEN_TIME)
+	co_time_reset_comm(node);
+#endif
+#if defined(CONFIG_CANOPEN_PDO)
+	co_pdo_reset_comm(node);
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		co_sdo_srv_reset_comm(&node->sdo_srv[i]);
 	}
+#endif
+#if defined(CONFIG_CANOPEN_SDO_CLIENT)
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		co_sdo_cli_reset_comm(&node->sdo_cli[i]);
+	}
+#endif
+#if defined(CONFIG_CANOPEN_MGR)
+	co_mgr_reset_comm(node);
 #endif
 }
 
@@ -107,10 +147,24 @@ void co_node_services_set_state(struct co_node *node, enum co_nmt_state from, en
 #if defined(CONFIG_CANOPEN_SYNC)
 	co_sync_set_state(node, to);
 #endif
+#if defined(CONFIG_CANOPEN_TIME)
+	co_time_set_state(node, to);
+#endif
+#if defined(CONFIG_CANOPEN_PDO)
+	co_pdo_set_state(node, to);
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER)
 	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
 		co_sdo_srv_set_state(&node->sdo_srv[i], to);
 	}
+#endif
+#if defined(CONFIG_CANOPEN_SDO_CLIENT)
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		co_sdo_cli_set_state(&node->sdo_cli[i], to);
+	}
+#endif
+#if defined(CONFIG_CANOPEN_MGR)
+	co_mgr_set_state(node, to);
 #endif
 }
 

@@ -47,6 +47,34 @@ void co_sync_reset_comm(struct co_node *node);
 void co_sync_set_state(struct co_node *node, enum co_nmt_state to);
 #endif
 
+#if defined(CONFIG_CANOPEN_TIME)
+/* TIME (time/time.c). */
+int co_time_init(struct co_node *node);
+void co_time_reset_comm(struct co_node *node);
+void co_time_set_state(struct co_node *node, enum co_nmt_state to);
+#endif
+
+#if defined(CONFIG_CANOPEN_PDO)
+/* PDO and MPDO (pdo/). */
+int co_pdo_init(struct co_node *node);
+void co_pdo_reset_comm(struct co_node *node);
+void co_pdo_set_state(struct co_node *node, enum co_nmt_state to);
+#endif
+
+#if defined(CONFIG_CANOPEN_SDO_CLIENT)
+/* SDO clients (sdo/sdo_cli.c). */
+int co_sdo_cli_init(struct co_sdo_cli *cli, struct co_node *node, uint8_t num);
+void co_sdo_cli_reset_comm(struct co_sdo_cli *cli);
+void co_sdo_cli_set_state(struct co_sdo_cli *cli, enum co_nmt_state to);
+#endif
+
+#if defined(CONFIG_CANOPEN_MGR)
+/* Manager: NMT master, boot-up, configuration manager (mgr/). */
+int co_mgr_init(struct co_node *node);
+void co_mgr_reset_comm(struct co_node *node);
+void co_mgr_set_state(struct co_node *node, enum co_nmt_state to);
+#endif
+
 /* Every service, in the order the node configures them. */
 void co_node_services_reset_comm(struct co_node *node);
 void co_node_services_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to);
