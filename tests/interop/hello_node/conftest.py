@@ -1,139 +1,23 @@
 # SPDX-License-Identifier: Apache-2.0
 """Fixtures: the hello_node image on a real vcan interface, driven by python-canopen.
 
-Run by twister's pytest harness (scenario sample.canopen.hello_node.interop, fixture vcan),
-which sets SAFELINE_IMAGE, SAFELINE_BUILD_DIR and SAFELINE_CAN_IFACES inside the VM.
+Run by twister's pytest harness (scenario sample.canopen.hello_node.interop, fixture vcan).
+The fixtures are shared with the other interop suites (../lib/safeline_interop.py).
 """
 
 import os
-import subprocess
-import threading
-import time
+import sys
 
-import can
-import canopen
 import pytest
 
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "lib"))
+
+from safeline_interop import (  # noqa: E402,F401
+    SDO_TIMEOUT, bus_log, device, dut, eds, iface, image, network)
+
 NODE_ID = 0x10
-SDO_TIMEOUT = 3.0
-
-
-def _env(name):
-    value = os.environ.get(name)
-    if not value:
-        pytest.skip(f"{name} is not set: run through scripts/twister -X vcan")
-    return value
 
 
 @pytest.fixture(scope="session")
-def iface():
-    return _env("SAFELINE_CAN_IFACES").split(",")[0]
-
-
-@pytest.fixture(scope="session")
-def image():
-    return _env("SAFELINE_IMAGE")
-
-
-@pytest.fixture(scope="session")
-def eds():
-    # The EDS as the firmware has it, regenerated from the built object dictionary.
-    path = os.path.join(_env("SAFELINE_BUILD_DIR"), "canopen_od", "hello_node", "hello_node.eds")
-    assert os.path.exists(path), path
-    return path
-
-
-@pytest.fixture
-def network(iface):
-    net = canopen.Network()
-    net.connect(interface="socketcan", channel=iface, receive_own_messages=False)
-    yield net
-    net.disconnect()
-
-
-@pytest.fixture
-def bus_log(network):
-    """Every frame on the bus from now on, with python-can's receive timestamps."""
-    frames = []
-
-    class Listener(can.Listener):
-        def on_message_received(self, msg):
-            frames.append(msg)
-
-    listener = Listener()
-    network.notifier.add_listener(listener)
-    yield frames
-    network.notifier.remove_listener(listener)
-
-
-class Device:
-    """The image as a process; its output goes to image-<n>.log in the build folder."""
-
-    runs = 0
-
-    def __init__(self, image, iface, network, eds, node_id=NODE_ID):
-        self.node = canopen.RemoteNode(node_id, eds)
-        # python-canopen waits 0.3 s for an answer; inside the VM system calls are slow and a
-        # 127-segment sub-block can take longer than that to be acknowledged.
-        self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
-        network.add_node(self.node)
-        self.cmd = [image, f"--can-if=0:{iface}", f"--node-id={node_id}"]
-        self.proc = None
-        self.up = threading.Event()
-        Device.runs += 1
-        self.log_path = os.path.join(os.environ.get("SAFELINE_BUILD_DIR", "."),
-                                     f"image-{Device.runs}.log")
-
-    def _drain(self):
-        # Keep reading so the image never blocks on a full pipe.
-        with open(self.log_path, "w") as log:
-            for line in self.proc.stdout:
-                log.write(line)
-                log.flush()
-                if "hello_node: node" in line and "up on" in line:
-                    self.up.set()
-
-    def start(self, wait_bootup=True):
-        # Listen for the boot-up before the process exists, so it cannot be missed.
-        got = threading.Event()
-
-        def on_hb(state):
-            if state == 0:
-                got.set()
-
-        self.node.nmt.add_heartbeat_callback(on_hb)
-        self.proc = subprocess.Popen(self.cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                     text=True)
-        self.drain = threading.Thread(target=self._drain, daemon=True)
-        self.drain.start()
-        assert self.up.wait(10), f"image did not come up (see {self.log_path})"
-        if wait_bootup:
-            assert got.wait(10), "no boot-up message"
-
-    def stop(self):
-        if self.proc is not None and self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        if self.proc is not None:
-            # The whole output, including what the image prints on its way out.
-            self.drain.join(timeout=10)
-
-
-@pytest.fixture
-def dut(image, iface, network, eds):
-    d = Device(image, iface, network, eds)
-    d.start()
-    yield d.node
-    d.stop()
-
-
-@pytest.fixture
-def device(image, iface, network, eds):
-    """The device, not yet started (tests that watch the start)."""
-    d = Device(image, iface, network, eds)
-    yield d
-    d.stop()
+def sample():
+    return {"node_id": NODE_ID, "od_name": "hello_node", "up_marker": "hello_node: node"}

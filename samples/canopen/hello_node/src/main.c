@@ -21,9 +21,8 @@
 #include <canopen/line.h>
 #include <canopen/node.h>
 
-#include "cmdline.h"
-#include "posix_native_task.h"
 #include "hello_node_od.h"
+#include "sample_common.h"
 
 LOG_MODULE_REGISTER(hello_node, LOG_LEVEL_INF);
 
@@ -31,26 +30,6 @@ LOG_MODULE_REGISTER(hello_node, LOG_LEVEL_INF);
 #define DATA_CAPACITY (128U * 1024U)
 
 #define DEFAULT_NODE_ID 0x10U
-
-/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
-static uint32_t node_id_arg;
-
-static void add_options(void)
-{
-	static struct args_struct_t opts[] = {
-		{
-			.option = "node-id",
-			.name = "1..127",
-			.type = 'u',
-			.dest = &node_id_arg,
-			.descript = "CANopen node-ID of this device (default 16)",
-		},
-		ARG_TABLE_ENDMARKER,
-	};
-
-	native_add_command_line_opts(opts);
-}
-NATIVE_TASK(add_options, PRE_BOOT_1, 20);
 
 static struct co_line line;
 static struct co_node node;
@@ -136,44 +115,14 @@ static const struct co_od_provider data_provider = {
 	.index_last = DATA_INDEX,
 };
 
-/* On the way out, the line's counters (tests read them to see back-pressure at work). */
-static void print_line_stats(void)
-{
-	struct co_line_stats st;
-
-	if (line.name == NULL) {
-		return;
-	}
-	co_line_get_stats(&line, &st);
-	printk("hello_node: line0 rx %u tx %u queued %u queue_max %u dropped %u errors %u "
-	       "overruns %u\n",
-	       st.rx_frames, st.tx_frames, st.tx_queued, st.tx_queue_max, st.tx_dropped,
-	       st.tx_errors, st.rx_overruns);
-}
-NATIVE_TASK(print_line_stats, ON_EXIT, 10);
-
-/* Line 0: SocketCAN when an interface was given, else the virtual bus. */
-static const struct device *line_device(void)
-{
-	const struct device *dev = device_get_binding("can_socketcan0");
-
-	if (dev != NULL && device_is_ready(dev)) {
-		return dev;
-	}
-	return device_get_binding("can_virtual0");
-}
-
 int main(void)
 {
-	const struct device *can = line_device();
+	const struct device *can = sample_line_device(0);
+	int node_id = sample_node_id(DEFAULT_NODE_ID);
 	uint32_t seconds = 0;
 	int err;
 
-	if (node_id_arg == UINT32_MAX) {
-		node_id_arg = DEFAULT_NODE_ID;
-	}
-	if (node_id_arg < 1U || node_id_arg > 127U) {
-		LOG_ERR("--node-id must be 1..127 (got %u)", node_id_arg);
+	if (node_id < 0) {
 		return 1;
 	}
 	if (can == NULL) {
@@ -183,7 +132,7 @@ int main(void)
 	err = co_line_init(&line, "line0", can);
 	if (err == 0) {
 		err = co_node_init(&node, "hello", &line, &hello_node_od_def, &od_ram,
-				   (uint8_t)node_id_arg);
+				   (uint8_t)node_id);
 	}
 	if (err == 0) {
 		err = co_od_provider_register(co_node_od(&node), &data_provider);
@@ -199,7 +148,8 @@ int main(void)
 		LOG_ERR("start failed (%d)", err);
 		return 1;
 	}
-	printk("hello_node: node %u up on %s\n", node_id_arg, can->name);
+	sample_print_stats_on_exit("hello_node", &line);
+	printk("hello_node: node %d up on %s\n", node_id, can->name);
 
 	for (;;) {
 		k_sleep(K_SECONDS(1));

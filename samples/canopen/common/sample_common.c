@@ -1,0 +1,84 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+#include <stdio.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include "cmdline.h"
+#include "posix_native_task.h"
+#include "sample_common.h"
+
+LOG_MODULE_REGISTER(sample, LOG_LEVEL_INF);
+
+/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
+static uint32_t node_id_arg;
+
+static void add_options(void)
+{
+	static struct args_struct_t opts[] = {
+		{
+			.option = "node-id",
+			.name = "1..127",
+			.type = 'u',
+			.dest = &node_id_arg,
+			.descript = "CANopen node-ID of this device",
+		},
+		ARG_TABLE_ENDMARKER,
+	};
+
+	native_add_command_line_opts(opts);
+}
+NATIVE_TASK(add_options, PRE_BOOT_1, 20);
+
+int sample_node_id(uint8_t dflt)
+{
+	if (node_id_arg == UINT32_MAX) {
+		return dflt;
+	}
+	if (node_id_arg < 1U || node_id_arg > 127U) {
+		LOG_ERR("--node-id must be 1..127 (got %u)", node_id_arg);
+		return -1;
+	}
+	return (int)node_id_arg;
+}
+
+const struct device *sample_line_device(unsigned int n)
+{
+	char name[24];
+	const struct device *dev;
+
+	snprintf(name, sizeof(name), "can_socketcan%u", n);
+	dev = device_get_binding(name);
+	if (dev != NULL && device_is_ready(dev)) {
+		return dev;
+	}
+	snprintf(name, sizeof(name), "can_virtual%u", n);
+	return device_get_binding(name);
+}
+
+static const char *stats_prefix;
+static struct co_line *stats_line;
+
+void sample_print_stats_on_exit(const char *prefix, struct co_line *line)
+{
+	stats_prefix = prefix;
+	stats_line = line;
+}
+
+static void print_line_stats(void)
+{
+	struct co_line_stats st;
+
+	if (stats_line == NULL || stats_line->name == NULL) {
+		return;
+	}
+	co_line_get_stats(stats_line, &st);
+	printk("%s: line0 rx %u tx %u queued %u queue_max %u dropped %u errors %u overruns %u\n",
+	       stats_prefix, st.rx_frames, st.tx_frames, st.tx_queued, st.tx_queue_max,
+	       st.tx_dropped, st.tx_errors, st.rx_overruns);
+}
+NATIVE_TASK(print_line_stats, ON_EXIT, 10);
