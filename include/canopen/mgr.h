@@ -1,0 +1,336 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/**
+ * @file
+ * @brief CANopen manager: NMT master (CiA 302 §5, CiA 302-2 §3-§4, §6).
+ *
+ * The NMT master sends NMT module control with the inhibit time 102Ah, supervises every
+ * assigned slave (1F81h) by heartbeat (1016h) or node guarding (1F81h guard bytes, 1F83h)
+ * and runs the CiA 302-2 boot-up: NMT startup (1F80h), boot NMT slave (identity 1F84h-1F88h,
+ * keep-alive, software version 1F52h-1F54h, configuration 1020h vs 1F26h/1F27h, restore
+ * 1F8Ah, concise DCF through the configuration manager, start error control, start), the
+ * error handler and the boot-up handler, request NMT 1F82h and request guarding 1F83h.
+ *
+ * All slaves boot in parallel: slave slot i uses SDO client i of the node
+ * (CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES).
+ *
+ * Indications run in the node's line thread with the node's mutex held; they must not block.
+ *
+ * @defgroup co_mgr NMT master
+ * @ingroup canopen
+ * @{
+ */
+
+#ifndef SAFELINE_INCLUDE_CANOPEN_MGR_H_
+#define SAFELINE_INCLUDE_CANOPEN_MGR_H_
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <canopen/line.h>
+#include <canopen/nmt.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct co_node;
+
+/** Boot result codes: 0 = OK, 'A'..'O' the error status of CiA 302-2 §3.8 Table 1. */
+enum co_mgr_status {
+	CO_MGR_ST_OK = 0,
+	/** Node not in the network list 1F81h. */
+	CO_MGR_ST_A = 'A',
+	/** No response to the 1000h upload. */
+	CO_MGR_ST_B = 'B',
+	/** 1000h differs from 1F84h. */
+	CO_MGR_ST_C = 'C',
+	/** 1018h:01 differs from 1F85h. */
+	CO_MGR_ST_D = 'D',
+	/** Check NMT state: no heartbeat. */
+	CO_MGR_ST_E = 'E',
+	/** Check NMT state: no node guarding reply. */
+	CO_MGR_ST_F = 'F',
+	/** Software check requested but 1F53h/1F54h not configured. */
+	CO_MGR_ST_G = 'G',
+	/** Software update needed but not allowed (1F81h bit 6 = 0). */
+	CO_MGR_ST_H = 'H',
+	/** Software update needed but the download failed. */
+	CO_MGR_ST_I = 'I',
+	/** Configuration download failed. */
+	CO_MGR_ST_J = 'J',
+	/** No heartbeat in start error control. */
+	CO_MGR_ST_K = 'K',
+	/** Slave was already Operational (keep-alive): success with a warning. */
+	CO_MGR_ST_L = 'L',
+	/** 1018h:02 differs from 1F86h. */
+	CO_MGR_ST_M = 'M',
+	/** 1018h:03 does not fit 1F87h (major equal, minor greater or equal). */
+	CO_MGR_ST_N = 'N',
+	/** 1018h:04 differs from 1F88h. */
+	CO_MGR_ST_O = 'O',
+	/** Boot not run yet. */
+	CO_MGR_ST_NONE = 0xff,
+};
+
+/** Steps of "boot NMT slave" (CiA 302-2 §3.4, our table order). */
+enum co_mgr_step {
+	CO_MGR_STEP_IDLE,
+	CO_MGR_STEP_ASSIGNED,
+	CO_MGR_STEP_BOOT_ALLOWED,
+	CO_MGR_STEP_DEVTYPE,
+	CO_MGR_STEP_VENDOR,
+	CO_MGR_STEP_PRODUCT,
+	CO_MGR_STEP_REVISION,
+	CO_MGR_STEP_SERIAL,
+	CO_MGR_STEP_KEEP_ALIVE,
+	CO_MGR_STEP_KEEP_ALIVE_RESET,
+	CO_MGR_STEP_SW_DATE,
+	CO_MGR_STEP_SW_TIME,
+	CO_MGR_STEP_CFG_DATE,
+	CO_MGR_STEP_CFG_TIME,
+	CO_MGR_STEP_RESTORE,
+	CO_MGR_STEP_RESTORE_RESET,
+	CO_MGR_STEP_DOWNLOAD,
+	CO_MGR_STEP_START_EC,
+	CO_MGR_STEP_START,
+	CO_MGR_STEP_COUNT,
+};
+
+/** Why a boot of one slave failed: which slave, step, object, expected and actual value. */
+struct co_mgr_boot_error {
+	uint8_t node_id;
+	/** enum co_mgr_status letter. */
+	uint8_t status;
+	enum co_mgr_step step;
+	/** Object concerned (slave object, e.g. 1018h:02), 0 if none. */
+	uint16_t index;
+	uint8_t sub;
+	/** Expected value (from the manager's 1F84h..., 1016h time ...). */
+	uint32_t expected;
+	/** Value found (0 if nothing was received). */
+	uint32_t actual;
+	/** SDO abort code of the failing transfer, 0 if none. */
+	uint32_t abort_code;
+};
+
+/** One line of the boot table (co_mgr_get_boot()). */
+struct co_mgr_boot_info {
+	uint8_t node_id;
+	/** 1F81h bit 0. */
+	bool assigned;
+	/** 1F81h bit 3. */
+	bool mandatory;
+	/** A boot process is running. */
+	bool booting;
+	/** enum co_mgr_status of the last finished boot (CO_MGR_ST_NONE: none yet). */
+	uint8_t status;
+	/** Identity read: 1000h, 1018h:01..04, and which of them were read (bit i). */
+	uint32_t device_type;
+	uint32_t identity[4];
+	uint8_t read_mask;
+	/** Attempts since the boot process started. */
+	uint16_t attempts;
+	/** Start of the boot process and end of the last attempt [µs, line time]. */
+	uint64_t started_us;
+	uint64_t finished_us;
+	/** The master's view of the slave's NMT state (1F82h read value: 0, 1, 4, 5, 7Fh). */
+	uint8_t nmt_state;
+	/** Last error (valid when status is an error letter). */
+	struct co_mgr_boot_error error;
+};
+
+/** Error-control events of a slave (co_mgr_ec_ind_t). */
+enum co_mgr_ec_event {
+	/** A boot-up message (700h+id, 00h) arrived. */
+	CO_MGR_EC_BOOTUP,
+	/** Heartbeat lost (1016h time elapsed). */
+	CO_MGR_EC_HB_LOST,
+	/** No node guarding reply within guard time x retry factor. */
+	CO_MGR_EC_GUARD_LOST,
+	/** The slave's reported NMT state changed. */
+	CO_MGR_EC_STATE,
+};
+
+/** Overall NMT startup state. */
+enum co_mgr_startup {
+	/** Not a master (1F80h bit 0 = 0) or not started. */
+	CO_MGR_STARTUP_IDLE,
+	/** Resetting slaves, booting them. */
+	CO_MGR_STARTUP_RUNNING,
+	/** Startup complete; normal operation. */
+	CO_MGR_STARTUP_DONE,
+	/** A mandatory slave failed: startup halted (no NMT Start, master stays Pre-op). */
+	CO_MGR_STARTUP_HALTED,
+};
+
+/**
+ * @brief Result of one boot attempt of a slave (OK, L or an error).
+ * @param err NULL on success, else the details (also logged).
+ */
+typedef void (*co_mgr_boot_ind_t)(struct co_node *node, uint8_t id, uint8_t status,
+				  const struct co_mgr_boot_error *err, void *user_data);
+
+/** @brief NMT startup finished (DONE) or halted (HALTED, @p err: the mandatory failure). */
+typedef void (*co_mgr_startup_ind_t)(struct co_node *node, enum co_mgr_startup result,
+				     const struct co_mgr_boot_error *err, void *user_data);
+
+/** @brief Error-control event of slave @p id; @p state the last known state. */
+typedef void (*co_mgr_ec_ind_t)(struct co_node *node, uint8_t id, enum co_mgr_ec_event event,
+				enum co_nmt_state state, void *user_data);
+
+/**
+ * @brief Software version hook (1F81h bits 5 and 6, CiA 302 §4 step 4).
+ *
+ * Called when slave @p id reports 1F52h date/time different from 1F53h/1F54h and an update is
+ * allowed (bit 6). The application updates the program (1F50h/1F51h) itself.
+ *
+ * @return 0: the software was updated and the boot goes on; otherwise the boot ends with I.
+ */
+typedef int (*co_mgr_sw_ind_t)(struct co_node *node, uint8_t id, uint32_t exp_date,
+			       uint32_t exp_time, uint32_t act_date, uint32_t act_time,
+			       void *user_data);
+
+/** @cond INTERNAL_HIDDEN */
+struct co_mgr;
+
+struct co_mgr_slave {
+	struct co_mgr *mgr;
+	struct co_timer timer;    /* boot step timeouts and retries */
+	struct co_timer ec_timer; /* heartbeat consumer / node guarding */
+	uint64_t started_us;
+	uint64_t finished_us;
+	uint32_t ident[5]; /* 1000h, 1018h:01..04 as read */
+	uint8_t buf[4];    /* upload buffer */
+	uint8_t load[4];   /* restore signature "load" */
+	uint32_t sw_date;
+	uint32_t cfg_date;
+	struct co_mgr_boot_error err;
+	uint16_t attempts;
+	uint16_t guard_ms;
+	uint16_t hb_ms;
+	uint8_t id; /* 0: slot free */
+	uint8_t slot;
+	uint8_t step;
+	uint8_t status;
+	uint8_t nmt_state; /* 1F82h read value */
+	uint8_t read_mask;
+	uint8_t guard_rf;
+	uint8_t guard_missed;
+	uint8_t guard_toggle; /* toggle bit expected in the next reply, 0xff: not yet known */
+	bool booting;
+	bool tried;
+	bool sdo_pending;
+	bool was_operational;
+	bool no_start;  /* 1F81h bit 2 = 0: error control only */
+	bool parked;    /* state set through 1F82h: no automatic re-boot */
+	bool hb_on;     /* heartbeat monitoring running */
+	bool hb_wait;   /* start error control: waiting for the first heartbeat */
+	bool guarding;  /* node guarding running */
+	bool guard_ans; /* reply seen since the last RTR */
+	bool ec_lost;
+	bool wait_reboot;    /* after an error-handler reset, waiting for the boot-up */
+	bool start_deferred; /* booted while a mandatory slave was still booting */
+};
+
+struct co_mgr_nmt_cmd {
+	uint8_t cs;
+	uint8_t id;
+	bool self;
+};
+
+struct co_mgr {
+	struct co_node *node;
+	struct co_rx ec_rx;          /* 700h..77Fh: boot-up, heartbeat, guarding replies */
+	struct co_timer nmt_timer;   /* inhibit time 102Ah */
+	struct co_timer start_timer; /* deferred startup steps */
+	struct co_timer boot_timer;  /* 1F89h */
+	struct co_mgr_nmt_cmd nmtq[CONFIG_CANOPEN_MGR_NMT_QUEUE];
+	uint64_t nmt_next_us;
+	uint16_t nmt_head;
+	uint16_t nmt_count;
+	uint8_t startup;    /* enum co_mgr_startup */
+	uint8_t phase;      /* internal startup phase */
+	uint8_t exclude_id; /* 1F82h 84h..8Fh requester */
+	bool boot_pending;  /* Reset communication seen; startup on Pre-operational */
+	bool od_update;     /* the manager writes 1F82h/1F83h itself */
+	bool nmt_self_busy; /* applying a command to ourselves */
+	struct co_mgr_boot_error halt_err;
+	struct co_mgr_slave slaves[CONFIG_CANOPEN_MGR_SLAVES];
+	co_mgr_boot_ind_t boot_ind;
+	void *boot_user_data;
+	co_mgr_startup_ind_t startup_ind;
+	void *startup_user_data;
+	co_mgr_ec_ind_t ec_ind;
+	void *ec_user_data;
+	co_mgr_sw_ind_t sw_ind;
+	void *sw_user_data;
+};
+/** @endcond */
+
+/**
+ * @brief Send an NMT command to node @p id, or to all nodes (@p id 0) including the master.
+ *
+ * Commands are queued and sent in order, at least 102Ah apart (never dropped). A broadcast
+ * is applied to the master's own NMT state after it is sent (the controller does not receive
+ * its own frames), CiA 302 §5.4.
+ *
+ * @retval 0 Queued (or sent).
+ * @retval -EINVAL @p id above 127 or an unknown command.
+ * @retval -ENOSPC The queue (CONFIG_CANOPEN_MGR_NMT_QUEUE) is full.
+ * @retval -EPERM The node is not an NMT master (1F80h bit 0 = 0).
+ */
+int co_mgr_nmt_req(struct co_node *node, uint8_t id, enum co_nmt_cs cs);
+
+/**
+ * @brief Start the boot process of slave @p id (as the boot-up handler would).
+ *
+ * @retval 0 Started (the result comes through the boot indication).
+ * @retval -EINVAL @p id outside 1..127 or the master's own ID.
+ * @retval -EALREADY A boot of @p id is running.
+ * @retval -ENOSPC No slave slot free.
+ */
+int co_mgr_boot_req(struct co_node *node, uint8_t id);
+
+/**
+ * @brief Read one line of the boot table.
+ *
+ * @retval 0 Filled.
+ * @retval -ENOENT @p id is neither assigned nor ever booted.
+ */
+int co_mgr_get_boot(struct co_node *node, uint8_t id, struct co_mgr_boot_info *info);
+
+/** @brief Current NMT startup state. */
+enum co_mgr_startup co_mgr_get_startup(struct co_node *node);
+
+/**
+ * @brief Clear the "set by request NMT" mark of slave @p id (1F82h writes park a slave: the
+ * boot-up handler then leaves it alone, CiA 302 §5.4).
+ */
+void co_mgr_release(struct co_node *node, uint8_t id);
+
+/** @brief Set the boot indication (NULL removes it). */
+void co_mgr_set_boot_ind(struct co_node *node, co_mgr_boot_ind_t cb, void *user_data);
+
+/** @brief Set the startup indication (NULL removes it). */
+void co_mgr_set_startup_ind(struct co_node *node, co_mgr_startup_ind_t cb, void *user_data);
+
+/** @brief Set the error-control indication (NULL removes it). */
+void co_mgr_set_ec_ind(struct co_node *node, co_mgr_ec_ind_t cb, void *user_data);
+
+/** @brief Set the software version hook (NULL: an update that is needed fails with I). */
+void co_mgr_set_sw_ind(struct co_node *node, co_mgr_sw_ind_t cb, void *user_data);
+
+/** @brief Name of a boot step ("DEVTYPE" ...). */
+const char *co_mgr_step_str(enum co_mgr_step step);
+
+#ifdef __cplusplus
+}
+#endif
+
+/** @} */
+
+#endif /* SAFELINE_INCLUDE_CANOPEN_MGR_H_ */
