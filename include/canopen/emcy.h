@@ -59,6 +59,13 @@ struct co_node;
 #define CO_EMCY_RPDO_TIMEOUT   0x8250U
 /** @} */
 
+/** @name Manufacturer field byte 0 of the stack's 8110h (which queue lost frames)
+ * @{
+ */
+#define CO_EMCY_OVERRUN_RX 0x01U
+#define CO_EMCY_OVERRUN_TX 0x02U
+/** @} */
+
 /** Base COB-ID of EMCY in the predefined connection set: 80h + node-ID. */
 #define CO_EMCY_COB_ID 0x080U
 
@@ -116,6 +123,15 @@ struct co_emcy {
 	bool enabled;
 	/* Our own writes to 1001h/1003h pass the refusing validate hooks. */
 	bool self_write;
+#if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
+	/* Line events: the node's listener, the controller state last reported, and the
+	 * timers that end the event-type errors 8110h and 8140h.
+	 */
+	struct co_line_listener listener;
+	struct co_timer overrun_timer;
+	struct co_timer recovered_timer;
+	uint8_t can_state;
+#endif
 	/* Consumer. */
 	struct co_rx cons_rx[CONFIG_CANOPEN_EMCY_CONSUMERS];
 	co_emcy_ind_t ind;

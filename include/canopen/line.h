@@ -92,10 +92,44 @@ enum co_line_event {
 /**
  * @brief Learn about line events (overruns, controller state changes, TX errors).
  *
- * Runs in the line thread without any node lock held. Must not block.
+ * The application's callback (co_line_set_event_cb()). Runs in the line thread without any
+ * node lock held, except CO_LINE_EV_TX_OVERFLOW and CO_LINE_EV_TX_ERROR raised by a send,
+ * which run in the sender's thread. Must not block.
  */
 typedef void (*co_line_event_cb_t)(struct co_line *line, enum co_line_event event, int arg,
 				   void *user_data);
+
+struct co_line_listener;
+
+/**
+ * @brief A line event for a listener (co_line_listener_add()).
+ *
+ * Always runs in the line thread (in simulation: the caller of co_line_process() or of the
+ * test injection), with the listener's lock held and no other node lock. Events raised by a
+ * send (TX overflow, TX error) are deferred to the line thread, so a listener never runs
+ * inside another node's call. Must not block.
+ *
+ * @param l The listener.
+ * @param event The event.
+ * @param arg As for co_line_event_cb_t.
+ */
+typedef void (*co_line_listener_cb_t)(struct co_line_listener *l, enum co_line_event event,
+				      int arg);
+
+/** A listener for line events; embedded in a service (e.g. a node's EMCY). */
+struct co_line_listener {
+	/** Handler; called with @ref lock held. */
+	co_line_listener_cb_t cb;
+	/** Owner's mutex (a node's), or NULL. */
+	struct k_mutex *lock;
+	/** Opaque pointer for the handler. */
+	void *user_data;
+
+	/** @cond INTERNAL_HIDDEN */
+	struct co_line_listener *next;
+	struct co_line *line;
+	/** @endcond */
+};
 
 /** A receiver: a COB-ID (optionally masked) bound to a handler. Embedded in a service. */
 struct co_rx {
@@ -189,6 +223,11 @@ struct co_line {
 	void *sink_user_data;
 	co_line_event_cb_t event_cb;
 	void *event_user_data;
+	/* Listeners of the nodes on the line, in registration order. */
+	struct co_line_listener *listeners;
+	/* Send-side events waiting for the line thread's listeners. */
+	atomic_t tx_overflow_pending;
+	atomic_t tx_error_pending;
 	struct co_line_stats stats;
 	/* Simulation mode: the time of the last co_line_rx()/co_line_process(). */
 	uint64_t sim_now;
@@ -269,8 +308,39 @@ int co_line_start(struct co_line *line, k_thread_stack_t *stack, size_t stack_si
  */
 int co_line_stop(struct co_line *line);
 
-/** @brief Set the callback for line events (NULL to remove). */
+/**
+ * @brief Set the application's callback for line events (NULL to remove).
+ *
+ * One per line; independent of the listeners (co_line_listener_add()), which the nodes use.
+ */
 void co_line_set_event_cb(struct co_line *line, co_line_event_cb_t cb, void *user_data);
+
+/** @brief Fill a listener; register it with co_line_listener_add(). */
+static inline void co_line_listener_init(struct co_line_listener *l, co_line_listener_cb_t cb,
+					 struct k_mutex *lock, void *user_data)
+{
+	*l = (struct co_line_listener){
+		.cb = cb,
+		.lock = lock,
+		.user_data = user_data,
+	};
+}
+
+/**
+ * @brief Register a listener for the line's events (co_node_init() registers the node's).
+ *
+ * Every listener gets every event, in registration order, after the application's
+ * callback. A listener registered on another line is moved.
+ *
+ * @retval 0 Registered (or already registered on @p line).
+ */
+int co_line_listener_add(struct co_line *line, struct co_line_listener *l);
+
+/**
+ * @brief Remove a listener. Safe on a listener that is not registered. A listener removed
+ * while its line reports an event may still get that event, not later ones.
+ */
+void co_line_listener_remove(struct co_line_listener *l);
 
 /** @} */
 

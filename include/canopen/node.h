@@ -85,7 +85,7 @@ struct co_node {
 	struct co_sync sync;
 #endif
 #if defined(CONFIG_CANOPEN_TIME)
-	struct co_time time;
+	struct co_time_svc time;
 #endif
 #if defined(CONFIG_CANOPEN_PDO)
 	struct co_pdo pdo;

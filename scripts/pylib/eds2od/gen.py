@@ -19,11 +19,30 @@ GROUP_ENUM = {"none": 0, "comm": 1, "app": 2, "manuf": 3}
 RAM_GROUPS = ["comm", "comm_vol", "manuf", "manuf_vol", "app", "app_vol"]
 
 # Counts checked against the Kconfig limit of the service that serves those objects: the
-# generated C has `BUILD_ASSERT(NAME_OD_CNT_<key> <= <symbol>)` inside `#ifdef <symbol>`.
-# A service that sizes its tables by Kconfig adds its pair here.
+# generated C has `BUILD_ASSERT(NAME_OD_CNT_<key> <= <symbol>)` inside `#ifdef <symbol>`, or,
+# when a guard is given, inside `#if defined(<guard>) && defined(<symbol>)` (the service's
+# switch: a build without the service may carry the objects for a tool to read).
+# A service that sizes its tables by Kconfig adds its entry here: key -> symbol or
+# (symbol, guard).
 COUNT_KCONFIG = {
     "SDO_SRV": "CONFIG_CANOPEN_SDO_SERVERS",
+    "SDO_CLI": ("CONFIG_CANOPEN_SDO_CLIENTS", "CONFIG_CANOPEN_SDO_CLIENT"),
+    "RPDO": ("CONFIG_CANOPEN_RPDOS", "CONFIG_CANOPEN_PDO"),
+    "TPDO": ("CONFIG_CANOPEN_TPDOS", "CONFIG_CANOPEN_PDO"),
+    "EM_HIST": ("CONFIG_CANOPEN_EMCY_HISTORY", "CONFIG_CANOPEN_EMCY"),
 }
+
+
+def count_checks(name: str) -> str:
+    """The BUILD_ASSERTs of COUNT_KCONFIG for the dictionary `name`."""
+    P = name.upper()
+    out = []
+    for k, v in COUNT_KCONFIG.items():
+        sym, guard = (v, None) if isinstance(v, str) else v
+        cond = f"#ifdef {sym}" if guard is None else f"#if defined({guard}) && defined({sym})"
+        out.append(f"{cond}\nBUILD_ASSERT({P}_OD_CNT_{k} <= {sym}, \"{name}: the OD has "
+                   f"more {k} objects than {sym}\");\n#endif\n")
+    return "".join(out)
 
 
 # --------------------------------------------------------------------------------------
@@ -392,9 +411,7 @@ def write_c(model: Model, name: str):
              f"BUILD_ASSERT({P}_OD_MAX_STAGED <= CONFIG_CANOPEN_OD_SCRATCH_SIZE,\n"
              f"\t     \"{name}: a value needs more staging than CONFIG_CANOPEN_OD_SCRATCH_SIZE\");\n"
              "#endif\n")
-    for k, sym in COUNT_KCONFIG.items():
-        c.append(f"#ifdef {sym}\nBUILD_ASSERT({P}_OD_CNT_{k} <= {sym}, \"{name}: the OD has "
-                 f"more {k} objects than {sym}\");\n#endif\n")
+    c.append(count_checks(name))
     c.append(f"BUILD_ASSERT({P}_OD_CNT_SUBS < 65536, \"too many sub-indexes\");\n\n")
 
     # defaults

@@ -76,13 +76,134 @@ void co_line_set_event_cb(struct co_line *line, co_line_event_cb_t cb, void *use
 	k_mutex_unlock(&line->lock);
 }
 
+static void report_app(struct co_line *line, enum co_line_event event, int arg)
+{
+	co_line_event_cb_t cb;
+	void *user_data;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	cb = line->event_cb;
+	user_data = line->event_user_data;
+	k_mutex_unlock(&line->lock);
+	if (cb != NULL) {
+		cb(line, event, arg, user_data);
+	}
+}
+
+/*
+ * Call every listener with its owner's lock held. line->lock is only held to step through
+ * the list (it is a leaf lock); a listener removed meanwhile ends the walk early.
+ */
+static void report_listeners(struct co_line *line, enum co_line_event event, int arg)
+{
+	struct co_line_listener *l;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	l = line->listeners;
+	k_mutex_unlock(&line->lock);
+
+	while (l != NULL) {
+		bool registered;
+
+		if (l->lock != NULL) {
+			k_mutex_lock(l->lock, K_FOREVER);
+		}
+		k_mutex_lock(&line->lock, K_FOREVER);
+		registered = (l->line == line);
+		k_mutex_unlock(&line->lock);
+		if (registered) {
+			l->cb(l, event, arg);
+		}
+		if (l->lock != NULL) {
+			k_mutex_unlock(l->lock);
+		}
+		k_mutex_lock(&line->lock, K_FOREVER);
+		l = (l->line == line) ? l->next : NULL;
+		k_mutex_unlock(&line->lock);
+	}
+}
+
 void co_line_report(struct co_line *line, enum co_line_event event, int arg)
 {
-	co_line_event_cb_t cb = line->event_cb;
+	report_app(line, event, arg);
+	report_listeners(line, event, arg);
+}
 
-	if (cb != NULL) {
-		cb(line, event, arg, line->event_user_data);
+void co_line_report_from_send(struct co_line *line, enum co_line_event event, int arg)
+{
+	report_app(line, event, arg);
+	/* The sender may hold its node's lock: taking the other nodes' locks here could
+	 * deadlock against the line thread, so the listeners hear of it from the line thread.
+	 */
+	if (event == CO_LINE_EV_TX_OVERFLOW) {
+		atomic_inc(&line->tx_overflow_pending);
+	} else {
+		atomic_set(&line->tx_error_pending, arg != 0 ? arg : -EIO);
 	}
+	co_line_wake(line);
+}
+
+void co_line_report_deferred(struct co_line *line)
+{
+	atomic_val_t err;
+
+	/* Several overflows since the last look are one event for the listeners. */
+	if (atomic_set(&line->tx_overflow_pending, 0) != 0) {
+		report_listeners(line, CO_LINE_EV_TX_OVERFLOW, 0);
+	}
+	err = atomic_set(&line->tx_error_pending, 0);
+	if (err != 0) {
+		report_listeners(line, CO_LINE_EV_TX_ERROR, (int)err);
+	}
+}
+
+static void listener_unlink(struct co_line *line, struct co_line_listener *l)
+{
+	struct co_line_listener **pp = &line->listeners;
+
+	while (*pp != NULL && *pp != l) {
+		pp = &(*pp)->next;
+	}
+	if (*pp == l) {
+		*pp = l->next;
+	}
+	l->next = NULL;
+	l->line = NULL;
+}
+
+int co_line_listener_add(struct co_line *line, struct co_line_listener *l)
+{
+	struct co_line_listener **pp;
+	struct co_line *old = l->line;
+
+	if (old != NULL && old != line) {
+		co_line_listener_remove(l);
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	pp = &line->listeners;
+	while (*pp != NULL && *pp != l) {
+		pp = &(*pp)->next;
+	}
+	if (*pp == NULL) {
+		/* Append: listeners hear events in registration order. */
+		*pp = l;
+		l->next = NULL;
+	}
+	l->line = line;
+	k_mutex_unlock(&line->lock);
+	return 0;
+}
+
+void co_line_listener_remove(struct co_line_listener *l)
+{
+	struct co_line *line = l->line;
+
+	if (line == NULL) {
+		return;
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	listener_unlink(line, l);
+	k_mutex_unlock(&line->lock);
 }
 
 /* --- Receive table --------------------------------------------------------------------- */
@@ -462,6 +583,7 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 		}
 	}
 	co_line_tx_drain(line);
+	co_line_report_deferred(line);
 	if (line->dev == NULL && k_msgq_num_used_get(&line->rxq) > 0U) {
 		/* Local frames sent by the handlers above are due at once. */
 		return now_us;
@@ -534,9 +656,9 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 
 	if (overflow) {
 		LOG_WRN("%s: TX queue full, frame %03x dropped", line->name, frame->id);
-		co_line_report(line, CO_LINE_EV_TX_OVERFLOW, 0);
+		co_line_report_from_send(line, CO_LINE_EV_TX_OVERFLOW, 0);
 	} else if (error) {
-		co_line_report(line, CO_LINE_EV_TX_ERROR, err);
+		co_line_report_from_send(line, CO_LINE_EV_TX_ERROR, err);
 	}
 	return err;
 }

@@ -21,6 +21,10 @@
 #define CO_LINE_F_STATE        4
 /* A wake message is in the RX queue. */
 #define CO_LINE_F_WAKE_PENDING 5
+/* The controller went bus-off since the thread last reported a state (recovery may have
+ * followed before the thread ran; bus-off must still be reported).
+ */
+#define CO_LINE_F_BUS_OFF      6
 
 /* Wake the line thread so it re-reads its deadline (no-op in simulation). */
 void co_line_wake(struct co_line *line);
@@ -38,7 +42,29 @@ int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64
 /* Simulation: dispatch the frames waiting for local delivery. */
 void co_line_local_drain(struct co_line *line);
 
-/* Report an event to the line's event callback. */
+/*
+ * Report an event to the application's callback and to the listeners. Line thread (or the
+ * simulation's driver) only, with no node lock held.
+ */
 void co_line_report(struct co_line *line, enum co_line_event event, int arg);
+
+/*
+ * Report an event raised by a send, in any thread and possibly under a node lock: the
+ * application's callback runs now, the listeners later in the line thread
+ * (co_line_report_deferred()).
+ */
+void co_line_report_from_send(struct co_line *line, enum co_line_event event, int arg);
+
+/* Line thread: give the listeners the events co_line_report_from_send() held back. */
+void co_line_report_deferred(struct co_line *line);
+
+/*
+ * Tests: emit a line event as the line thread would (application callback, then listeners).
+ * Call from the thread that drives the line (a simulation test's thread), without node locks.
+ */
+static inline void co_line_inject_event(struct co_line *line, enum co_line_event event, int arg)
+{
+	co_line_report(line, event, arg);
+}
 
 #endif /* SAFELINE_SUBSYS_CANOPEN_CORE_LINE_INTERNAL_H_ */

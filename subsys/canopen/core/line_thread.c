@@ -30,8 +30,10 @@ void co_line_wake(struct co_line *line)
 	if (line->dev == NULL || !atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
 		return;
 	}
-	/* The line thread re-reads its deadline before sleeping anyway. */
-	if (k_current_get() == line->tid) {
+	/* The line thread re-reads its deadline before sleeping anyway. Compared by address:
+	 * line->tid is written by co_line_start() while the new thread may already be sending.
+	 */
+	if (k_current_get() == &line->thread) {
 		return;
 	}
 	/* One wake message at a time, so wakes never crowd frames out of the queue; a full
@@ -78,6 +80,9 @@ static void line_state_cb(const struct device *dev, enum can_state state,
 	struct co_line *line = user_data;
 
 	atomic_set(&line->can_state, (atomic_val_t)state);
+	if (state == CAN_STATE_BUS_OFF) {
+		atomic_set_bit(&line->flags, CO_LINE_F_BUS_OFF);
+	}
 	atomic_set_bit(&line->flags, CO_LINE_F_STATE);
 	co_line_wake(line);
 }
@@ -96,7 +101,14 @@ static void line_report_async(struct co_line *line)
 		co_line_report(line, CO_LINE_EV_RX_OVERRUN, 0);
 	}
 	if (atomic_test_and_clear_bit(&line->flags, CO_LINE_F_STATE)) {
-		co_line_report(line, CO_LINE_EV_CAN_STATE, (int)atomic_get(&line->can_state));
+		int state = (int)atomic_get(&line->can_state);
+
+		/* States are coalesced, but a bus-off already over is still reported. */
+		if (atomic_test_and_clear_bit(&line->flags, CO_LINE_F_BUS_OFF) &&
+		    state != CAN_STATE_BUS_OFF) {
+			co_line_report(line, CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+		}
+		co_line_report(line, CO_LINE_EV_CAN_STATE, state);
 	}
 	err = atomic_set(&line->tx_async_err, 0);
 	if (err != 0) {

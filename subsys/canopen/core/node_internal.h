@@ -59,6 +59,12 @@ void co_time_set_state(struct co_node *node, enum co_nmt_state to);
 int co_pdo_init(struct co_node *node);
 void co_pdo_reset_comm(struct co_node *node);
 void co_pdo_set_state(struct co_node *node, enum co_nmt_state to);
+/*
+ * A SYNC was received or produced at @p now_us with @p counter (0 without counter):
+ * synchronous TPDOs are sampled and sent, synchronous RPDOs committed. @p window_us is 1007h
+ * (0 = no window): samples sent later and RPDOs received later are dropped.
+ */
+void co_pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uint32_t window_us);
 #endif
 
 #if defined(CONFIG_CANOPEN_SDO_CLIENT)

@@ -17,7 +17,12 @@
  * - 1003h manufacturer info (bits 31..16) is msef[0..1], little endian.
  * - Reset Communication reloads 1001h and 1003h from the dictionary; errors raised by the
  *   application stay active (their bits are put back into 1001h), the stack's own
- *   communication errors are dropped (monitoring starts afresh).
+ *   communication errors are dropped (monitoring starts afresh), except 8120h while the
+ *   controller is still error passive.
+ * - Line events (a listener on the node's line): 8110h on an RX queue overrun or a TX queue
+ *   overflow (msef[0] 01h / 02h), 8120h while error passive, 8140h on each return from
+ *   bus-off; 8110h and 8140h end after CONFIG_CANOPEN_EMCY_COMM_HOLD_MS without a new
+ *   occurrence. Entering bus-off applies 1029h sub1.
  */
 
 #include <errno.h>
@@ -217,6 +222,20 @@ static void history_notify(struct co_od *od, const struct co_od_req *req, void *
 		od_put(node, IDX_ERR_FIELD, s, 0U, 4U);
 	}
 }
+
+#if defined(CO_OD_HOOK_READ_CHECK)
+/* CiA 301 §7.5.2.3 / `[CON]`: an entry beyond the number of errors holds no data. */
+static uint32_t history_read_check(const struct co_od *od, const struct co_od_info *info,
+				   enum co_od_writer reader, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	if (info->sub == 0U || info->sub <= od_uint(node, IDX_ERR_FIELD, 0, 0U)) {
+		return 0U;
+	}
+	return CO_SDO_AB_NO_DATA;
+}
+#endif
 
 static uint32_t reg_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
@@ -428,6 +447,128 @@ void co_emcy_clear_internal(struct co_node *node, uint16_t code)
 	(void)clear_locked(node, code);
 }
 
+/* --- Line events: 8110h, 8120h, 8140h ------------------------------------------------------ */
+
+#if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
+
+static void hold(struct co_node *node, struct co_timer *timer)
+{
+	if (CONFIG_CANOPEN_EMCY_COMM_HOLD_MS > 0) {
+		co_timer_start(node->line, timer,
+			       co_line_time(node->line) +
+				       (uint64_t)CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * 1000U);
+	}
+}
+
+static void overrun_expired(struct co_timer *timer, uint64_t now_us)
+{
+	(void)clear_locked(timer->user_data, CO_EMCY_CAN_OVERRUN);
+}
+
+static void recovered_expired(struct co_timer *timer, uint64_t now_us)
+{
+	(void)clear_locked(timer->user_data, CO_EMCY_BUS_OFF_RECOV);
+}
+
+/* Frames were lost: one 8110h while it lasts, so a flood cannot become an EMCY flood. */
+static void line_overrun(struct co_node *node, uint8_t which)
+{
+	const uint8_t msef[5] = {which};
+
+	if (find_active(&node->emcy, CO_EMCY_CAN_OVERRUN) < 0) {
+		(void)raise_locked(node, CO_EMCY_CAN_OVERRUN, CO_EMCY_REG_COMMUNICATION, msef,
+				   true);
+	}
+	hold(node, &node->emcy.overrun_timer);
+}
+
+static void line_state(struct co_node *node, enum can_state to)
+{
+	struct co_emcy *em = &node->emcy;
+	enum can_state from = (enum can_state)em->can_state;
+
+	if (to == CAN_STATE_STOPPED || to == from) {
+		/* A stopped controller says nothing about the bus. */
+		return;
+	}
+	em->can_state = (uint8_t)to;
+	if (to == CAN_STATE_BUS_OFF) {
+		/* Nothing can be sent now; 8140h follows the recovery. CiA 301 §7.5.2.33:
+		 * bus-off is a communication error for 1029h sub1.
+		 */
+		LOG_WRN("%s: bus-off", node->name);
+		error_behaviour(node, 1U);
+		return;
+	}
+	if (from == CAN_STATE_BUS_OFF) {
+		/* Every recovery is reported, even while an earlier one is still held. */
+		(void)raise_locked(node, CO_EMCY_BUS_OFF_RECOV, CO_EMCY_REG_COMMUNICATION, NULL,
+				   true);
+		hold(node, &em->recovered_timer);
+	}
+	if (to == CAN_STATE_ERROR_PASSIVE) {
+		if (find_active(em, CO_EMCY_CAN_PASSIVE) < 0) {
+			(void)raise_locked(node, CO_EMCY_CAN_PASSIVE, CO_EMCY_REG_COMMUNICATION,
+					   NULL, true);
+		}
+	} else {
+		/* Error-active or warning: both are "error active" in ISO 11898-1. */
+		(void)clear_locked(node, CO_EMCY_CAN_PASSIVE);
+	}
+}
+
+static void line_event(struct co_line_listener *l, enum co_line_event event, int arg)
+{
+	struct co_node *node = l->user_data;
+
+	switch (event) {
+	case CO_LINE_EV_RX_OVERRUN:
+		line_overrun(node, CO_EMCY_OVERRUN_RX);
+		break;
+	case CO_LINE_EV_TX_OVERFLOW:
+		line_overrun(node, CO_EMCY_OVERRUN_TX);
+		break;
+	case CO_LINE_EV_CAN_STATE:
+		line_state(node, (enum can_state)arg);
+		break;
+	default:
+		/* A failed send is logged and counted by the line; CiA 301 has no code for it. */
+		break;
+	}
+}
+
+static void line_events_init(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+
+	/* The node may be initialised again (tests): leave the old line's list first. */
+	co_line_listener_remove(&em->listener);
+	co_line_listener_init(&em->listener, line_event, &node->lock, node);
+	co_timer_init(&em->overrun_timer, overrun_expired, &node->lock, node);
+	co_timer_init(&em->recovered_timer, recovered_expired, &node->lock, node);
+	em->can_state = (uint8_t)CAN_STATE_ERROR_ACTIVE;
+	(void)co_line_listener_add(node->line, &em->listener);
+}
+
+static void line_events_reset_comm(struct co_node *node)
+{
+	struct co_emcy *em = &node->emcy;
+
+	co_timer_stop(&em->overrun_timer);
+	co_timer_stop(&em->recovered_timer);
+	/* Still error passive: the condition has not gone away (already recorded in 1003h). */
+	if (em->can_state == (uint8_t)CAN_STATE_ERROR_PASSIVE &&
+	    find_active(em, CO_EMCY_CAN_PASSIVE) < 0 &&
+	    em->n_active < CONFIG_CANOPEN_EMCY_ACTIVE_ERRORS) {
+		em->active[em->n_active++] = (struct co_emcy_active){
+			.code = CO_EMCY_CAN_PASSIVE,
+			.reg = CO_EMCY_REG_GENERIC | CO_EMCY_REG_COMMUNICATION,
+			.internal = true};
+	}
+}
+
+#endif /* CONFIG_CANOPEN_EMCY_LINE_EVENTS */
+
 /* --- Node interface ----------------------------------------------------------------------- */
 
 int co_emcy_init(struct co_node *node)
@@ -435,7 +576,18 @@ int co_emcy_init(struct co_node *node)
 	struct co_emcy *em = &node->emcy;
 	const struct co_od_hook hooks[] = {
 		{IDX_ERR_REG, IDX_ERR_REG, 0, 0, reg_validate, NULL, node},
+#if defined(CO_OD_HOOK_READ_CHECK)
+		{.index_first = IDX_ERR_FIELD,
+		 .index_last = IDX_ERR_FIELD,
+		 .sub_first = 0,
+		 .sub_last = 254,
+		 .validate = history_validate,
+		 .notify = history_notify,
+		 .user_data = node,
+		 .read_check = history_read_check},
+#else
 		{IDX_ERR_FIELD, IDX_ERR_FIELD, 0, 254, history_validate, history_notify, node},
+#endif
 		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
 		{IDX_INHIBIT, IDX_INHIBIT, 0, 0, NULL, inhibit_notify, node},
 		{IDX_CONSUMER, IDX_CONSUMER, 1, 127, NULL, cons_notify, node},
@@ -446,6 +598,9 @@ int co_emcy_init(struct co_node *node)
 		co_rx_init(&em->cons_rx[i], 0U, cons_rx, &node->lock, node);
 	}
 	em->cob_id = COB_INVALID;
+#if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
+	line_events_init(node);
+#endif
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
@@ -478,6 +633,9 @@ void co_emcy_reset_comm(struct co_node *node)
 			i++;
 		}
 	}
+#if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
+	line_events_reset_comm(node);
+#endif
 	update_reg(node);
 
 	count = (uint8_t)od_uint(node, IDX_CONSUMER, 0, 0U);

@@ -5,6 +5,7 @@
 import os
 import re
 import shutil
+import subprocess
 
 import pytest
 
@@ -125,3 +126,59 @@ def test_store_override(tmp_path):
     h = (out / "store_od.h").read_text()
     assert re.search(r"struct \{\n\t\tuint32_t x2001_kept;\n\t\} manuf;", h)
     assert re.search(r"struct \{\n\t\tuint32_t x2000_scratch;\n\t\} manuf_vol;", h)
+
+
+def _count(h, name, key):
+    m = re.search(rf"#define {name.upper()}_OD_CNT_{key} (\d+)U", h)
+    assert m, key
+    return int(m.group(1))
+
+
+def _syntax_check(out, name, defines):
+    cmd = ["gcc", "-std=gnu11", "-fsyntax-only", "-I", os.path.join(BASE, "include"),
+           "-I", str(out)] + [f"-D{d}" for d in defines] + [str(out / f"{name}_od.c")]
+    return subprocess.run(cmd, capture_output=True, text=True)
+
+
+def _with_client_sdo(eds, tmp_path):
+    """io401.eds plus one client SDO parameter record, 1280h (io401 has none)."""
+    text = open(eds, encoding="utf-8").read()
+    m = re.search(r"\[OptionalObjects\]\nSupportedObjects=(\d+)\n", text)
+    n = int(m.group(1)) + 1
+    text = text.replace(m.group(0), f"[OptionalObjects]\nSupportedObjects={n}\n{n}=0x1280\n")
+    subs = [("Highest sub-index supported", "0x0005", "const", "3"),
+            ("COB-ID client to server", "0x0007", "rw", "0x80000000"),
+            ("COB-ID server to client", "0x0007", "rw", "0x80000000"),
+            ("Node-ID of the SDO server", "0x0005", "rw", "0")]
+    rec = "\n[1280]\nParameterName=SDO client parameter\nObjectType=0x9\nSubNumber=0x4\n"
+    for i, (pn, dt, acc, dv) in enumerate(subs):
+        rec += (f"\n[1280sub{i}]\nParameterName={pn}\nObjectType=0x7\nDataType={dt}\n"
+                f"AccessType={acc}\nDefaultValue={dv}\nPDOMapping=0\n")
+    text = text.replace("\n[1400]\n", rec + "\n[1400]\n", 1)
+    path = tmp_path / "io_cli.eds"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("key,sym,guard", [
+    ("RPDO", "CONFIG_CANOPEN_RPDOS", "CONFIG_CANOPEN_PDO"),
+    ("TPDO", "CONFIG_CANOPEN_TPDOS", "CONFIG_CANOPEN_PDO"),
+    ("EM_HIST", "CONFIG_CANOPEN_EMCY_HISTORY", "CONFIG_CANOPEN_EMCY"),
+    ("SDO_CLI", "CONFIG_CANOPEN_SDO_CLIENTS", "CONFIG_CANOPEN_SDO_CLIENT"),
+])
+def test_counts_checked_against_kconfig_only_with_the_service(tmp_path, key, sym, guard):
+    """A dictionary with more objects than the service's Kconfig limit does not build, but
+    only when the service is enabled."""
+    out = tmp_path / "gen"
+    eds = os.path.join(DATA, "io401.eds")
+    if key == "SDO_CLI":
+        eds = _with_client_sdo(eds, tmp_path)
+    r = run_eds2od(eds, out, "io")
+    assert r.returncode == 0, r.stderr
+    n = _count((out / "io_od.h").read_text(), "io", key)
+    assert n > 0, f"io401.eds should have {key} objects"
+    assert _syntax_check(out, "io", [f"{guard}=1", f"{sym}={n}"]).returncode == 0
+    r = _syntax_check(out, "io", [f"{guard}=1", f"{sym}={n - 1}"])
+    assert r.returncode != 0
+    assert f"more {key} objects than {sym}" in r.stderr
+    assert _syntax_check(out, "io", [f"{sym}={n - 1}"]).returncode == 0, "service off"

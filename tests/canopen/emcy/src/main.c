@@ -17,6 +17,8 @@
 #include <canopen/node.h>
 #include <canopen/sdo_abort.h>
 
+#include "line_internal.h"
+
 #include "emcy_bare_od.h"
 #include "emcy_test_od.h"
 
@@ -117,6 +119,20 @@ static uint32_t od_read_u(uint16_t index, uint8_t sub)
 	co_node_lock(&t.node);
 	zassert_equal(co_od_read(co_node_od(&t.node), index, sub, 0, buf, sizeof(buf), &len,
 				 CO_OD_WRITER_SDO),
+		      0U, "read %04x:%u", index, sub);
+	co_node_unlock(&t.node);
+	return (uint32_t)co_od_le_get(buf, len);
+}
+
+/* The stored value, as the application sees it (no SDO read checks). */
+static uint32_t od_read_app(uint16_t index, uint8_t sub)
+{
+	uint8_t buf[8] = {0};
+	size_t len = 0;
+
+	co_node_lock(&t.node);
+	zassert_equal(co_od_read(co_node_od(&t.node), index, sub, 0, buf, sizeof(buf), &len,
+				 CO_OD_WRITER_APP),
 		      0U, "read %04x:%u", index, sub);
 	co_node_unlock(&t.node);
 	return (uint32_t)co_od_le_get(buf, len);
@@ -311,7 +327,7 @@ ZTEST(co_emcy, test_history_write_zero_clears_other_writes_refused_06090030h)
 	zassert_equal(od_write_u(0x1003, 1, 0, 4), CO_SDO_AB_READONLY, "entries are ro");
 	zassert_equal(od_write_u(0x1003, 0, 0, 1), 0U);
 	zassert_equal(od_read_u(0x1003, 0), 0);
-	zassert_equal(od_read_u(0x1003, 1), 0, "entries cleared");
+	zassert_equal(od_read_app(0x1003, 1), 0, "entries cleared");
 	zassert_true(co_emcy_is_active(&t.node, 0x4210), "clearing history clears no error");
 	zassert_ok(co_emcy_raise(&t.node, 0x5000, 0, NULL));
 	zassert_equal(od_read_u(0x1003, 0), 1);
@@ -544,4 +560,173 @@ ZTEST(co_emcy, test_node_without_emcy_objects_tracks_errors_and_sends_nothing)
 	zassert_true(co_emcy_is_active(&bare, 0x8130));
 	zassert_equal(co_nmt_get_state(&bare), CO_NMT_PRE_OPERATIONAL,
 		      "without 1029h a communication error leaves Operational");
+}
+
+/* --- Line events (injected as the line thread would report them) ------------------------- */
+
+static void line_event(enum co_line_event ev, int arg)
+{
+	co_line_inject_event(&t.line, ev, arg);
+}
+
+ZTEST(co_emcy, test_rx_overrun_raises_8110h_once_then_clears_after_hold_time)
+{
+	const uint8_t rx_info[5] = {CO_EMCY_OVERRUN_RX};
+
+	t.now = 10 * MS;
+	co_line_process(&t.line, t.now);
+	line_event(CO_LINE_EV_RX_OVERRUN, 0);
+	assert_emcy(0, EMCY_ID, 0x8110, 0x11, rx_info);
+	zassert_equal(od_read_u(0x1001, 0), 0x11, "generic + communication");
+	zassert_equal(od_read_u(0x1003, 1), 0x00018110U, "1003h info 01h = RX queue");
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL, "1029h not applied");
+
+	run_until(500 * MS);
+	line_event(CO_LINE_EV_RX_OVERRUN, 0);
+	zassert_equal(t.n_sent, 1, "one 8110h while it lasts");
+	run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS - 1);
+	zassert_equal(t.n_sent, 1, "each overrun restarts the hold time");
+	run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
+	zassert_equal(t.n_sent, 2);
+	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
+	zassert_false(co_emcy_is_active(&t.node, 0x8110));
+}
+
+ZTEST(co_emcy, test_tx_overflow_raises_8110h_from_the_line_thread)
+{
+	const uint8_t tx_info[5] = {CO_EMCY_OVERRUN_TX};
+
+	/* As co_line_send() reports it: deferred to the line thread's next pass. */
+	co_line_report_from_send(&t.line, CO_LINE_EV_TX_OVERFLOW, 0);
+	zassert_equal(t.n_sent, 0, "not from the sender's context");
+	co_line_process(&t.line, t.now);
+	assert_emcy(0, EMCY_ID, 0x8110, 0x11, tx_info);
+	zassert_equal(od_read_u(0x1003, 1), 0x00028110U);
+}
+
+ZTEST(co_emcy, test_error_passive_raises_8120h_cleared_when_error_active)
+{
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_WARNING);
+	zassert_equal(t.n_sent, 0, "warning is still error active");
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	assert_emcy(0, EMCY_ID, 0x8120, 0x11, NULL);
+	zassert_true(co_emcy_is_active(&t.node, 0x8120));
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(t.n_sent, 1, "same state, nothing new");
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_WARNING);
+	zassert_equal(t.n_sent, 2);
+	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
+	zassert_equal(od_read_u(0x1001, 0), 0x00);
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL);
+}
+
+ZTEST(co_emcy, test_bus_off_applies_1029h_and_recovery_raises_8140h)
+{
+	nmt(0x01); /* Operational */
+	t.n_sent = 0;
+	t.now = 20 * MS;
+	co_line_process(&t.line, t.now);
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	assert_emcy(0, EMCY_ID, 0x8120, 0x11, NULL);
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL,
+		      "1029h sub1 = 0: bus-off sends Operational to Pre-operational");
+	zassert_equal(t.n_sent, 1, "nothing to send while bus-off");
+
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
+	zassert_equal(t.n_sent, 3);
+	assert_emcy(1, EMCY_ID, 0x8140, 0x11, NULL);
+	assert_emcy(2, EMCY_ID, 0x0000, 0x11, NULL); /* 8120h cleared, 8140h still held */
+	zassert_equal(od_read_u(0x1003, 1), 0x00008140U);
+	zassert_true(co_emcy_is_active(&t.node, 0x8140));
+	zassert_false(co_emcy_is_active(&t.node, 0x8120));
+
+	run_until(20 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
+	zassert_equal(t.n_sent, 4);
+	assert_emcy(3, EMCY_ID, 0x0000, 0x00, NULL);
+	zassert_equal(od_read_u(0x1001, 0), 0x00);
+}
+
+ZTEST(co_emcy, test_bus_off_1029h_1_and_2)
+{
+	nmt(0x01);
+	zassert_equal(od_write_u(0x1029, 1, 1, 1), 0U);
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_OPERATIONAL, "1: no change");
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	zassert_true(co_emcy_is_active(&t.node, 0x8140), "recovered into error passive");
+	zassert_true(co_emcy_is_active(&t.node, 0x8120));
+
+	zassert_equal(od_write_u(0x1029, 1, 2, 1), 0U);
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_STOPPED, "2: Stopped");
+}
+
+ZTEST(co_emcy, test_reset_communication_keeps_8120h_while_still_passive)
+{
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	line_event(CO_LINE_EV_RX_OVERRUN, 0);
+	zassert_equal(od_read_u(0x1001, 0), 0x11);
+	nmt(0x82); /* Reset communication */
+	zassert_true(co_emcy_is_active(&t.node, 0x8120), "still passive");
+	zassert_false(co_emcy_is_active(&t.node, 0x8110), "an event error restarts");
+	zassert_equal(od_read_u(0x1001, 0), 0x11);
+	t.n_sent = 0;
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
+	assert_emcy(0, EMCY_ID, 0x0000, 0x00, NULL);
+}
+
+static void app_event_cb(struct co_line *line, enum co_line_event event, int arg, void *user_data)
+{
+	int *calls = user_data;
+
+	/* The application's callback runs first, without the node's lock. */
+	zassert_equal(t.n_sent, 0);
+	calls[0]++;
+	calls[1] = arg;
+}
+
+ZTEST(co_emcy, test_application_line_callback_still_called)
+{
+	int calls[2] = {0};
+
+	co_line_set_event_cb(&t.line, app_event_cb, calls);
+	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(calls[0], 1);
+	zassert_equal(calls[1], CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(t.n_sent, 1, "and the node's listener too");
+	co_line_set_event_cb(&t.line, NULL, NULL);
+}
+
+ZTEST(co_emcy, test_history_read_beyond_count_aborts_08000024h)
+{
+#if defined(CO_OD_HOOK_READ_CHECK)
+	uint8_t buf[4];
+	size_t len;
+	uint32_t ab;
+
+	zassert_ok(co_emcy_raise(&t.node, 0x5000, 0, NULL));
+	zassert_ok(co_emcy_raise(&t.node, 0x6000, 0, NULL));
+	zassert_equal(od_read_u(0x1003, 0), 2);
+	zassert_equal(od_read_u(0x1003, 2), 0x5000U);
+	co_node_lock(&t.node);
+	ab = co_od_read(co_node_od(&t.node), 0x1003, 3, 0, buf, sizeof(buf), &len,
+			CO_OD_WRITER_SDO);
+	co_node_unlock(&t.node);
+	zassert_equal(ab, CO_SDO_AB_NO_DATA, "sub3 > count 2: %08x", ab);
+	zassert_equal(od_write_u(0x1003, 0, 0, 1), 0U);
+	co_node_lock(&t.node);
+	ab = co_od_read(co_node_od(&t.node), 0x1003, 1, 0, buf, sizeof(buf), &len,
+			CO_OD_WRITER_SDO);
+	co_node_unlock(&t.node);
+	zassert_equal(ab, CO_SDO_AB_NO_DATA, "empty history");
+	co_node_lock(&t.node);
+	ab = co_od_read(co_node_od(&t.node), 0x1003, 9, 0, buf, sizeof(buf), &len,
+			CO_OD_WRITER_SDO);
+	co_node_unlock(&t.node);
+	zassert_equal(ab, CO_SDO_AB_NO_SUB, "beyond the array: no sub-index");
+#else
+	/* Needs the dictionary's read-check hook (CO_OD_HOOK_READ_CHECK, doc/emcy.md). */
+	ztest_test_skip();
+#endif
 }

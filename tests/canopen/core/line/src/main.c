@@ -12,6 +12,8 @@
 
 #include <canopen/line.h>
 
+#include "line_internal.h"
+
 #define MAX_LOG 32
 
 struct fixture {
@@ -397,4 +399,70 @@ ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 
 	co_line_get_stats(&fx.line, &st);
 	zassert_equal(st.rx_frames, 0, "local frames are not counted as received from the bus");
+}
+
+/* --- Listeners ------------------------------------------------------------------------------ */
+
+struct listener_log {
+	struct co_line_listener l;
+	int tag;
+};
+
+static void listener_cb(struct co_line_listener *l, enum co_line_event event, int arg)
+{
+	struct listener_log *ll = CONTAINER_OF(l, struct listener_log, l);
+
+	/* Called with the owner's lock held (recursive: lock again succeeds at once). */
+	zassert_ok(k_mutex_lock(l->lock, K_NO_WAIT));
+	k_mutex_unlock(l->lock);
+	record(ll->tag * 100 + (int)event * 10 + (arg & 7), 0);
+}
+
+ZTEST(co_line, test_listeners_hear_events_after_the_application_in_order)
+{
+	static struct listener_log a = {.tag = 1};
+	static struct listener_log b = {.tag = 2};
+
+	co_line_listener_init(&a.l, listener_cb, &fx.node_lock, NULL);
+	co_line_listener_init(&b.l, listener_cb, &fx.node_lock, NULL);
+	zassert_ok(co_line_listener_add(&fx.line, &a.l));
+	zassert_ok(co_line_listener_add(&fx.line, &b.l));
+	zassert_ok(co_line_listener_add(&fx.line, &a.l), "adding twice is harmless");
+
+	co_line_inject_event(&fx.line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(fx.event_len, 1, "the application's callback as before");
+	zassert_equal(fx.event_args[0], CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(fx.log_len, 2, "each listener once");
+	zassert_equal(fx.log[0], 100 + CO_LINE_EV_CAN_STATE * 10 + CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(fx.log[1], 200 + CO_LINE_EV_CAN_STATE * 10 + CAN_STATE_ERROR_PASSIVE);
+
+	co_line_listener_remove(&a.l);
+	co_line_listener_remove(&a.l);
+	co_line_inject_event(&fx.line, CO_LINE_EV_RX_OVERRUN, 0);
+	zassert_equal(fx.log_len, 3);
+	zassert_equal(fx.log[2], 200 + CO_LINE_EV_RX_OVERRUN * 10);
+	co_line_listener_remove(&b.l);
+}
+
+ZTEST(co_line, test_send_side_events_reach_listeners_in_process_only)
+{
+	static struct listener_log a = {.tag = 1};
+	struct can_frame f = tx_frame(0x281);
+
+	co_line_listener_init(&a.l, listener_cb, &fx.node_lock, NULL);
+	zassert_ok(co_line_listener_add(&fx.line, &a.l));
+	fx.sink_result = -EAGAIN;
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE; i++) {
+		zassert_ok(co_line_send(&fx.line, &f));
+	}
+	zassert_equal(co_line_send(&fx.line, &f), -ENOBUFS);
+	zassert_equal(co_line_send(&fx.line, &f), -ENOBUFS);
+	zassert_equal(fx.event_len, 2, "application: at once, each time");
+	zassert_equal(fx.log_len, 0, "listeners: not in the sender's context");
+	co_line_process(&fx.line, 0);
+	zassert_equal(fx.log_len, 1, "listeners: once, from the line's pass");
+	zassert_equal(fx.log[0], 100 + CO_LINE_EV_TX_OVERFLOW * 10);
+	co_line_process(&fx.line, 0);
+	zassert_equal(fx.log_len, 1);
+	co_line_listener_remove(&a.l);
 }
