@@ -4,8 +4,9 @@
  */
 
 /*
- * SYNC object (CiA 301 §7.2.5): producer (1005h bit 30, period 1006h, counter 1019h) and
- * consumer (the 1005h COB-ID). Writes take effect at once through OD hooks.
+ * SYNC object (CiA 301 §7.2.5): producer (1005h bit 30, period 1006h, counter 1019h),
+ * consumer (the 1005h COB-ID) and the synchronous window 1007h handed to the PDOs. Writes
+ * take effect at once through OD hooks.
  *
  * Decisions (doc/sync.md):
  * - SYNC runs in Pre-operational and Operational; the counter restarts at 1 whenever the
@@ -13,6 +14,8 @@
  * - A SYNC whose length does not match 1019h (0 without counter, 1 with) is ignored and
  *   raises EMCY 8240h; the next good SYNC clears it.
  * - The producer's own SYNC is indicated to the application like a received one.
+ * - Each SYNC runs: the application's indication, the synchronous PDOs (with the 1007h
+ *   window, which applies from the next SYNC after a write), the post-PDO indication.
  */
 
 #include <errno.h>
@@ -29,6 +32,7 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 
 #define IDX_COB_ID   0x1005U
 #define IDX_PERIOD   0x1006U
+#define IDX_WINDOW   0x1007U
 #define IDX_OVERFLOW 0x1019U
 
 #define COB_GEN BIT(30)
@@ -47,10 +51,19 @@ static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint6
 	return co_od_le_get(buf, len);
 }
 
-static void indicate(struct co_node *node, uint8_t counter)
+/* One SYNC: the application, then the synchronous PDOs, then the application again. */
+static void indicate(struct co_node *node, uint8_t counter, uint64_t now_us)
 {
-	if (node->sync.ind != NULL) {
-		node->sync.ind(node, counter, node->sync.ind_user_data);
+	struct co_sync *s = &node->sync;
+
+	if (s->ind != NULL) {
+		s->ind(node, counter, s->ind_user_data);
+	}
+#if defined(CONFIG_CANOPEN_PDO)
+	co_pdo_sync(node, counter, now_us, s->window_us);
+#endif
+	if (s->post_ind != NULL) {
+		s->post_ind(node, counter, s->post_ind_user_data);
 	}
 }
 
@@ -61,7 +74,7 @@ static bool producing(const struct co_sync *s)
 	return s->enabled && (s->cob_id & COB_GEN) != 0U && s->period_us != 0U;
 }
 
-static void send_sync(struct co_node *node)
+static void send_sync(struct co_node *node, uint64_t now_us)
 {
 	struct co_sync *s = &node->sync;
 	struct can_frame f = {.id = s->cob_id & 0x7ffU};
@@ -74,7 +87,7 @@ static void send_sync(struct co_node *node)
 		s->counter = counter >= s->overflow ? 1U : (uint8_t)(counter + 1U);
 	}
 	(void)co_node_send(node, &f);
-	indicate(node, counter);
+	indicate(node, counter, now_us);
 }
 
 static void timer_handler(struct co_timer *timer, uint64_t now_us)
@@ -86,7 +99,7 @@ static void timer_handler(struct co_timer *timer, uint64_t now_us)
 	if (!producing(s)) {
 		return;
 	}
-	send_sync(node);
+	send_sync(node, now_us);
 	/* Keep the cadence; after a long stall start afresh rather than burst. */
 	if (co_time_before_eq(next, now_us)) {
 		next = now_us + s->period_us;
@@ -125,7 +138,7 @@ static void sync_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 #if defined(CONFIG_CANOPEN_EMCY)
 	co_emcy_clear_internal(node, SYNC_LENGTH_ERROR);
 #endif
-	indicate(node, want != 0U ? frame->data[0] : 0U);
+	indicate(node, want != 0U ? frame->data[0] : 0U, now_us);
 }
 
 static void rx_configure(struct co_node *node)
@@ -181,6 +194,14 @@ static void period_notify(struct co_od *od, const struct co_od_req *req, void *u
 	producer_restart(node);
 }
 
+static void window_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+
+	/* Applies from the next SYNC on. */
+	node->sync.window_us = (uint32_t)co_od_req_uint(req);
+}
+
 static uint32_t overflow_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_node *node = user_data;
@@ -215,6 +236,7 @@ int co_sync_init(struct co_node *node)
 	const struct co_od_hook hooks[] = {
 		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
 		{IDX_PERIOD, IDX_PERIOD, 0, 0, NULL, period_notify, node},
+		{IDX_WINDOW, IDX_WINDOW, 0, 0, NULL, window_notify, node},
 		{IDX_OVERFLOW, IDX_OVERFLOW, 0, 0, overflow_validate, overflow_notify, node},
 	};
 
@@ -235,6 +257,7 @@ void co_sync_reset_comm(struct co_node *node)
 		s->cob_id = (uint32_t)od_uint(node, IDX_COB_ID, 0, CO_SYNC_COB_ID);
 	}
 	s->period_us = (uint32_t)od_uint(node, IDX_PERIOD, 0, 0U);
+	s->window_us = (uint32_t)od_uint(node, IDX_WINDOW, 0, 0U);
 	s->overflow = (uint8_t)od_uint(node, IDX_OVERFLOW, 0, 0U);
 	if (s->overflow == 1U || s->overflow > 240U) {
 		s->overflow = 0U;
@@ -260,5 +283,13 @@ void co_sync_set_ind(struct co_node *node, co_sync_ind_t cb, void *user_data)
 	co_node_lock(node);
 	node->sync.ind = cb;
 	node->sync.ind_user_data = user_data;
+	co_node_unlock(node);
+}
+
+void co_sync_set_post_ind(struct co_node *node, co_sync_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->sync.post_ind = cb;
+	node->sync.post_ind_user_data = user_data;
 	co_node_unlock(node);
 }

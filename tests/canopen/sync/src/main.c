@@ -34,6 +34,8 @@ static struct {
 	uint64_t now;
 	int n_ind;
 	uint8_t ind_counter[MAX_TX];
+	char order[MAX_TX + 1];
+	int n_order;
 } t;
 
 static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
@@ -47,7 +49,15 @@ static int sink(struct co_line *line, const struct can_frame *frame, void *user_
 static void sync_ind(struct co_node *node, uint8_t counter, void *user_data)
 {
 	zassert_true(t.n_ind < MAX_TX);
+	t.order[t.n_order++] = 'a';
 	t.ind_counter[t.n_ind++] = counter;
+}
+
+static void sync_post_ind(struct co_node *node, uint8_t counter, void *user_data)
+{
+	zassert_true(t.n_order < MAX_TX);
+	zassert_equal(counter, t.ind_counter[t.n_ind - 1], "same SYNC");
+	t.order[t.n_order++] = 'b';
 }
 
 static void run_until(uint64_t at)
@@ -233,4 +243,19 @@ ZTEST(co_sync, test_no_sync_in_stopped_counter_restarts_after)
 	run_until(110 * MS);
 	zassert_equal(t.n_sent, 1);
 	zassert_equal(t.sent[0].data[0], 1, "counter restarts at 1 after Stopped");
+}
+
+ZTEST(co_sync, test_post_indication_follows_each_sync)
+{
+	co_sync_set_post_ind(&t.node, sync_post_ind, NULL);
+	zassert_equal(od_write_u(0x1007, 0, 1000, 4), 0U, "1007h window accepted");
+	rx(0x080, 0, NULL);
+	zassert_equal(od_write_u(0x1005, 0, 0x40000080U, 4), 0U);
+	zassert_equal(od_write_u(0x1006, 0, 10000, 4), 0U);
+	run_until(20 * MS);
+	zassert_equal(t.n_ind, 3, "one received, two produced");
+	zassert_str_equal(t.order, "ababab", "pre, then post, for every SYNC");
+	co_sync_set_post_ind(&t.node, NULL, NULL);
+	run_until(30 * MS);
+	zassert_equal(t.n_order, 7, "removed");
 }
