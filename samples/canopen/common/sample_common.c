@@ -61,22 +61,26 @@ const struct device *sample_line_device(unsigned int n)
 }
 
 static const char *stats_prefix;
-static struct co_line *stats_line;
+/* Read by the exit task in whatever thread ends the process: published atomically, after the
+ * prefix.
+ */
+static atomic_ptr_t stats_line;
 
 void sample_print_stats_on_exit(const char *prefix, struct co_line *line)
 {
 	stats_prefix = prefix;
-	stats_line = line;
+	(void)atomic_ptr_set(&stats_line, line);
 }
 
 static void print_line_stats(void)
 {
+	struct co_line *line = atomic_ptr_get(&stats_line);
 	struct co_line_stats st;
 
-	if (stats_line == NULL || stats_line->name == NULL) {
+	if (line == NULL) {
 		return;
 	}
-	co_line_get_stats(stats_line, &st);
+	co_line_get_stats(line, &st);
 	printk("%s: line0 rx %u tx %u queued %u queue_max %u dropped %u errors %u overruns %u\n",
 	       stats_prefix, st.rx_frames, st.tx_frames, st.tx_queued, st.tx_queue_max,
 	       st.tx_dropped, st.tx_errors, st.rx_overruns);

@@ -1,0 +1,582 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * manager: a CiA 302 manager (node 1) boots a network of hello_node slaves.
+ *
+ * The manager's dictionary (objdict/manager.dcf) is the network description: slaves 2..5
+ * assigned in 1F81h (2 and 3 mandatory), their expected identity in 1F85h-1F87h, the boot
+ * time 1F89h, heartbeat consumer entries in 1016h and the expected configuration date/time
+ * 1F26h/1F27h. Each slave gets the concise DCF generated from objdict/slave.dcf (heartbeat
+ * 100 ms, setpoint 500, 1020h). Node 5 is expected with another product code than the one
+ * hello_node reports, so its boot ends with error M and the sample shows the error report.
+ *
+ * By default the slaves run in this process, each on its own line thread: the manager on line
+ * 0, slave n on line n-1 (can_virtual0..4, one virtual bus; or SocketCAN with --can-if).
+ * --slaves=0 runs the manager alone, for slaves in other processes.
+ *
+ * Output: a boot table when the NMT startup finishes, then one line per NMT or heartbeat
+ * event. Events reach the main thread through a message queue, so nothing is printed from a
+ * line thread with a node lock held.
+ */
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <zephyr/device.h>
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <can_virtual.h>
+#include <canopen/cfg.h>
+#include <canopen/line.h>
+#include <canopen/mgr.h>
+#include <canopen/node.h>
+
+#include "cmdline.h"
+#include "hello_node_od.h"
+#include "manager_od.h"
+#include "posix_native_task.h"
+#include "sample_common.h"
+#include "slave_cdcf.h"
+
+LOG_MODULE_REGISTER(manager, LOG_LEVEL_INF);
+
+#define MANAGER_ID  1U
+#define FIRST_SLAVE 2U
+#define MAX_SLAVES  4U
+
+/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
+static uint32_t slaves_arg;
+static uint32_t cycle_arg;
+static uint32_t cut_arg;
+
+static void add_options(void)
+{
+	static struct args_struct_t opts[] = {
+		{
+			.option = "slaves",
+			.name = "0..4",
+			.type = 'u',
+			.dest = &slaves_arg,
+			.descript = "hello_node slaves run in this process (nodes 2.., lines 1..; "
+				    "default 4, 0 = the manager alone)",
+		},
+		{
+			.option = "cycle",
+			.name = "node",
+			.type = 'u',
+			.dest = &cycle_arg,
+			.descript = "power-cycle this in-process slave 1 s after the startup "
+				    "(default 4, 0 = none)",
+		},
+		{
+			.option = "cut",
+			.name = "node",
+			.type = 'u',
+			.dest = &cut_arg,
+			.descript = "cut this in-process slave off the virtual bus 2 s after the "
+				    "startup, for 1 s (default 3, 0 = none)",
+		},
+		ARG_TABLE_ENDMARKER,
+	};
+
+	native_add_command_line_opts(opts);
+}
+NATIVE_TASK(add_options, PRE_BOOT_1, 21);
+
+struct slave {
+	struct co_line line;
+	struct co_node node;
+	struct hello_node_od_ram ram;
+};
+
+static struct slave slaves[MAX_SLAVES];
+static K_THREAD_STACK_ARRAY_DEFINE(slave_stacks, MAX_SLAVES, CONFIG_CANOPEN_LINE_STACK_SIZE);
+
+static struct co_line mline;
+static struct co_node mgr;
+static struct manager_od_ram mram;
+static struct co_cfg cfg;
+static K_THREAD_STACK_DEFINE(mline_stack, CONFIG_CANOPEN_LINE_STACK_SIZE);
+
+/* --- Events: line threads -> main thread ------------------------------------------------- */
+
+enum ev_kind {
+	EV_STARTUP,
+	EV_BOOT,
+	EV_EC,
+	EV_OWN_STATE,
+	EV_HB,
+};
+
+struct event {
+	uint64_t t_us;
+	struct co_mgr_boot_error err;
+	uint8_t kind;
+	uint8_t id;
+	uint8_t status; /* EV_BOOT: letter; EV_STARTUP: enum co_mgr_startup */
+	uint8_t ec;     /* enum co_mgr_ec_event, or enum co_hb_event for EV_HB */
+	uint8_t state;  /* enum co_nmt_state */
+	bool has_err;
+};
+
+K_MSGQ_DEFINE(events, sizeof(struct event), 64, 8);
+static atomic_t events_lost;
+
+static void post(struct event *ev)
+{
+	ev->t_us = co_line_time(&mline);
+	if (k_msgq_put(&events, ev, K_NO_WAIT) != 0) {
+		atomic_inc(&events_lost);
+	}
+}
+
+/* Indications: manager line thread, manager lock held; they only queue. */
+static void on_boot(struct co_node *node, uint8_t id, uint8_t status,
+		    const struct co_mgr_boot_error *err, void *user_data)
+{
+	struct event ev = {.kind = EV_BOOT, .id = id, .status = status, .has_err = err != NULL};
+
+	if (err != NULL) {
+		ev.err = *err;
+	}
+	post(&ev);
+}
+
+static void on_startup(struct co_node *node, enum co_mgr_startup result,
+		       const struct co_mgr_boot_error *err, void *user_data)
+{
+	struct event ev = {.kind = EV_STARTUP, .status = (uint8_t)result, .has_err = err != NULL};
+
+	if (err != NULL) {
+		ev.err = *err;
+	}
+	post(&ev);
+}
+
+static void on_ec(struct co_node *node, uint8_t id, enum co_mgr_ec_event event,
+		  enum co_nmt_state state, void *user_data)
+{
+	struct event ev = {.kind = EV_EC, .id = id, .ec = (uint8_t)event, .state = (uint8_t)state};
+
+	post(&ev);
+}
+
+/*
+ * The CiA 301 heartbeat consumer of the manager (1016h) reports the states the slaves send.
+ * The manager's own indication covers boot-ups and losses; its state view also follows the
+ * commands it sends, so the states come from here.
+ */
+static void on_hb(struct co_node *node, uint8_t id, enum co_hb_event event, enum co_nmt_state state,
+		  void *user_data)
+{
+	struct event ev = {.kind = EV_HB, .id = id, .ec = (uint8_t)event, .state = (uint8_t)state};
+
+	/* Losses are the manager's (on_ec). */
+	if (event == CO_HB_EV_STARTED || event == CO_HB_EV_STATE || event == CO_HB_EV_RECOVERED) {
+		post(&ev);
+	}
+}
+
+static int on_own_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to,
+			void *user_data)
+{
+	struct event ev = {.kind = EV_OWN_STATE, .id = co_node_id(node), .state = (uint8_t)to};
+
+	post(&ev);
+	return 0;
+}
+
+/* --- Printing ------------------------------------------------------------------------------ */
+
+static const char *status_text(uint8_t st)
+{
+	switch (st) {
+	case CO_MGR_ST_A:
+		return "not in the network list 1F81h";
+	case CO_MGR_ST_B:
+		return "no answer to the 1000h upload";
+	case CO_MGR_ST_C:
+		return "device type differs (1F84h)";
+	case CO_MGR_ST_D:
+		return "vendor-ID differs (1F85h)";
+	case CO_MGR_ST_E:
+		return "no heartbeat (check NMT state)";
+	case CO_MGR_ST_F:
+		return "no node-guarding reply (check NMT state)";
+	case CO_MGR_ST_G:
+		return "software version objects not configured";
+	case CO_MGR_ST_H:
+		return "software update needed, not allowed";
+	case CO_MGR_ST_I:
+		return "software update failed";
+	case CO_MGR_ST_J:
+		return "configuration download failed";
+	case CO_MGR_ST_K:
+		return "no heartbeat in start error control";
+	case CO_MGR_ST_L:
+		return "was already operational";
+	case CO_MGR_ST_M:
+		return "product code differs (1F86h)";
+	case CO_MGR_ST_N:
+		return "revision differs (1F87h)";
+	case CO_MGR_ST_O:
+		return "serial number differs (1F88h)";
+	default:
+		return "?";
+	}
+}
+
+static void result_str(uint8_t st, char *buf, size_t len)
+{
+	if (st == CO_MGR_ST_OK) {
+		snprintf(buf, len, "OK");
+	} else if (st == CO_MGR_ST_NONE) {
+		snprintf(buf, len, "-");
+	} else {
+		snprintf(buf, len, "%c", st);
+	}
+}
+
+/* "status M (product code differs (1F86h)) in PRODUCT: 1018h:02 expected ... actual ..." */
+static void error_str(const struct co_mgr_boot_error *e, char *buf, size_t len)
+{
+	int n = snprintf(buf, len, "%s, step %s", status_text(e->status), co_mgr_step_str(e->step));
+
+	if (e->index != 0U && n > 0 && (size_t)n < len) {
+		n += snprintf(buf + n, len - n, ", %04Xh:%02X expected %08X actual %08X", e->index,
+			      e->sub, e->expected, e->actual);
+	}
+	if (e->abort_code != 0U && n > 0 && (size_t)n < len) {
+		(void)snprintf(buf + n, len - n, ", SDO abort %08X", e->abort_code);
+	}
+}
+
+static void ident_str(const struct co_mgr_boot_info *b, int i, char *buf, size_t len)
+{
+	/* read_mask bit 0: 1000h, bits 1..4: 1018h:01..04 */
+	if ((b->read_mask & BIT(i + 1)) != 0U) {
+		snprintf(buf, len, "%08X", b->identity[i]);
+	} else {
+		snprintf(buf, len, "%-8s", "-");
+	}
+}
+
+static void print_table(void)
+{
+	static const char rule[] = "  ----  ---------  --------  --------  --------  ------  "
+				   "---------  ------------------------------";
+
+	printk("\n  node  role       vendor    product   revision  result  boot time  details\n");
+	printk("%s\n", rule);
+	/* Row by row (co_mgr_get_boot() locks): no console output with the manager locked. */
+	for (unsigned int id = 1; id <= 127U; id++) {
+		struct co_mgr_boot_info b;
+		char v[12], p[12], r[12], res[4], det[160] = "";
+		char ms[16] = "-";
+
+		if (co_mgr_get_boot(&mgr, (uint8_t)id, &b) != 0 || !b.assigned) {
+			continue;
+		}
+		ident_str(&b, 0, v, sizeof(v));
+		ident_str(&b, 1, p, sizeof(p));
+		ident_str(&b, 2, r, sizeof(r));
+		result_str(b.status, res, sizeof(res));
+		if (b.status != CO_MGR_ST_NONE && b.finished_us >= b.started_us) {
+			snprintf(ms, sizeof(ms), "%.1f ms",
+				 (double)(b.finished_us - b.started_us) / 1e3);
+		}
+		if (b.status != CO_MGR_ST_OK && b.status != CO_MGR_ST_NONE) {
+			error_str(&b.error, det, sizeof(det));
+		} else if (b.status == CO_MGR_ST_NONE) {
+			if (b.booting) {
+				snprintf(det, sizeof(det), "booting (attempt %u)", b.attempts);
+			} else {
+				snprintf(det, sizeof(det), "not booted");
+			}
+		}
+		printk("  %4u  %-9s  %s  %s  %s  %-6s  %9s%s%s\n", id,
+		       b.mandatory ? "mandatory" : "optional", v, p, r, res, ms,
+		       det[0] != '\0' ? "  " : "", det);
+	}
+	printk("%s\n\n", rule);
+}
+
+static const char *ec_text(uint8_t ec)
+{
+	switch (ec) {
+	case CO_MGR_EC_BOOTUP:
+		return "boot-up";
+	case CO_MGR_EC_HB_LOST:
+		return "heartbeat lost";
+	case CO_MGR_EC_GUARD_LOST:
+		return "node guarding lost";
+	default:
+		return "state";
+	}
+}
+
+static bool booted_ok(uint8_t id)
+{
+	struct co_mgr_boot_info b;
+
+	return co_mgr_get_boot(&mgr, id, &b) == 0 && b.status == CO_MGR_ST_OK;
+}
+
+static void print_event(const struct event *ev, uint64_t start_us)
+{
+	double t = (double)(ev->t_us - start_us) / 1e6;
+	char det[160];
+
+	switch (ev->kind) {
+	case EV_BOOT:
+		if (ev->status == CO_MGR_ST_OK) {
+			printk("[%8.3f s] node %3u  booted OK\n", t, ev->id);
+		} else {
+			error_str(&ev->err, det, sizeof(det));
+			printk("[%8.3f s] node %3u  boot failed: %c, %s\n", t, ev->id, ev->status,
+			       det);
+		}
+		break;
+	case EV_EC:
+		/* States are printed from the heartbeats (EV_HB). */
+		if (ev->ec != CO_MGR_EC_STATE) {
+			printk("[%8.3f s] node %3u  %s\n", t, ev->id, ec_text(ev->ec));
+		}
+		break;
+	case EV_HB:
+		if (ev->ec != CO_HB_EV_RECOVERED) {
+			printk("[%8.3f s] node %3u  %s\n", t, ev->id,
+			       co_nmt_state_str((enum co_nmt_state)ev->state));
+		} else if (booted_ok(ev->id)) {
+			/*
+			 * Only for slaves the manager supervises: a slave it did not configure
+			 * (node 5) keeps its own heartbeat period, longer than 1016h expects.
+			 */
+			printk("[%8.3f s] node %3u  heartbeat back (%s)\n", t, ev->id,
+			       co_nmt_state_str((enum co_nmt_state)ev->state));
+		}
+		break;
+	case EV_OWN_STATE:
+		printk("[%8.3f s] node %3u  %s (manager)\n", t, ev->id,
+		       co_nmt_state_str((enum co_nmt_state)ev->state));
+		break;
+	default:
+		break;
+	}
+}
+
+/* --- Demo: what happens to the network after the startup ------------------------------------ */
+
+enum demo_action {
+	DEMO_CYCLE,
+	DEMO_CUT,
+	DEMO_RESTORE,
+	DEMO_COUNT,
+};
+
+/* When, in ms after the startup (in this order). */
+static const int64_t demo_at_ms[DEMO_COUNT] = {1000, 2000, 3000};
+
+static bool on_virtual_bus(const struct device *dev)
+{
+	return strncmp(dev->name, "can_virtual", 11) == 0;
+}
+
+static void demo(enum demo_action a, unsigned int cycle, unsigned int cut, uint64_t start_us)
+{
+	double t = (double)(co_line_time(&mline) - start_us) / 1e6;
+
+	switch (a) {
+	case DEMO_CYCLE:
+		if (cycle != 0U) {
+			/* A slave that loses power and comes back: the boot-up handler boots it. */
+			printk("[%8.3f s] node %3u  power-cycled (local Reset node)\n", t, cycle);
+			(void)co_nmt_req(&slaves[cycle - FIRST_SLAVE].node, CO_NMT_CS_RESET_NODE);
+		}
+		break;
+	case DEMO_CUT:
+		if (cut != 0U) {
+			/*
+			 * Its heartbeat stops: the error handler resets it (1F81h bit 3, 1F80h bits
+			 * 4 and 6 clear) and, without a boot-up, boots it again a while later.
+			 */
+			printk("[%8.3f s] node %3u  cut off the bus\n", t, cut);
+			(void)can_virtual_cut(slaves[cut - FIRST_SLAVE].line.dev);
+		}
+		break;
+	case DEMO_RESTORE:
+		if (cut != 0U) {
+			printk("[%8.3f s] node %3u  back on the bus\n", t, cut);
+			(void)can_virtual_restore(slaves[cut - FIRST_SLAVE].line.dev);
+		}
+		break;
+	default:
+		break;
+	}
+}
+
+/* --- Set-up -------------------------------------------------------------------------------- */
+
+static int start_slave(unsigned int i)
+{
+	struct slave *s = &slaves[i];
+	const struct device *can = sample_line_device(i + 1U);
+	static const char *const names[MAX_SLAVES] = {"line1", "line2", "line3", "line4"};
+	static const char *const node_names[MAX_SLAVES] = {"slave2", "slave3", "slave4", "slave5"};
+	int err;
+
+	if (can == NULL) {
+		LOG_ERR("no CAN controller for line %u", i + 1U);
+		return -ENODEV;
+	}
+	err = co_line_init(&s->line, names[i], can);
+	if (err == 0) {
+		err = co_node_init(&s->node, node_names[i], &s->line, &hello_node_od_def, &s->ram,
+				   (uint8_t)(FIRST_SLAVE + i));
+	}
+	if (err == 0) {
+		err = co_line_start(&s->line, slave_stacks[i],
+				    K_THREAD_STACK_SIZEOF(slave_stacks[i]),
+				    CONFIG_CANOPEN_LINE_THREAD_PRIORITY);
+	}
+	if (err == 0) {
+		err = co_node_start(&s->node);
+	}
+	return err;
+}
+
+static int start_manager(uint8_t id)
+{
+	const struct device *can = sample_line_device(0);
+	int err;
+
+	if (can == NULL) {
+		LOG_ERR("no CAN controller for line 0");
+		return -ENODEV;
+	}
+	err = co_line_init(&mline, "line0", can);
+	if (err == 0) {
+		err = co_node_init(&mgr, "manager", &mline, &manager_od_def, &mram, id);
+	}
+	if (err == 0) {
+		err = co_cfg_init(&cfg, &mgr);
+	}
+	/* Every slave gets the same configuration (1F22h:2..5). */
+	for (uint8_t n = FIRST_SLAVE; err == 0 && n < FIRST_SLAVE + MAX_SLAVES; n++) {
+		err = co_cfg_set_concise_dcf(&cfg, n, slave_cdcf, sizeof(slave_cdcf));
+	}
+	if (err != 0) {
+		return err;
+	}
+	co_mgr_set_boot_ind(&mgr, on_boot, NULL);
+	co_mgr_set_startup_ind(&mgr, on_startup, NULL);
+	co_mgr_set_ec_ind(&mgr, on_ec, NULL);
+	co_hb_set_ind(&mgr, on_hb, NULL);
+	co_nmt_set_state_ind(&mgr, on_own_state, NULL);
+	err = co_line_start(&mline, mline_stack, K_THREAD_STACK_SIZEOF(mline_stack),
+			    CONFIG_CANOPEN_LINE_THREAD_PRIORITY);
+	if (err == 0) {
+		/* The NMT startup runs by itself from 1F80h in the manager's line thread. */
+		err = co_node_start(&mgr);
+	}
+	printk("manager: node %u on %s\n", id, can->name);
+	return err;
+}
+
+int main(void)
+{
+	unsigned int n_slaves = slaves_arg == UINT32_MAX ? MAX_SLAVES : slaves_arg;
+	unsigned int cycle = cycle_arg == UINT32_MAX ? 4U : cycle_arg;
+	unsigned int cut = cut_arg == UINT32_MAX ? 3U : cut_arg;
+	unsigned int next = DEMO_COUNT; /* next demo action; DEMO_COUNT: none pending */
+	int64_t done_ms = 0;
+	int id = sample_node_id(MANAGER_ID);
+	bool live = false;
+	uint64_t start_us;
+	struct event ev;
+	int err;
+
+	if (id < 0) {
+		return 1;
+	}
+	if (id >= (int)FIRST_SLAVE && id < (int)(FIRST_SLAVE + MAX_SLAVES)) {
+		LOG_ERR("--node-id %d is a slave of the network description (2..5)", id);
+		return 1;
+	}
+	if (n_slaves > MAX_SLAVES) {
+		LOG_ERR("--slaves must be 0..%u (got %u)", MAX_SLAVES, n_slaves);
+		return 1;
+	}
+	if (cycle != 0U && (cycle < FIRST_SLAVE || cycle >= FIRST_SLAVE + n_slaves)) {
+		cycle = 0U; /* not a slave of this process */
+	}
+	if (cut != 0U && (cut < FIRST_SLAVE || cut >= FIRST_SLAVE + n_slaves ||
+			  !on_virtual_bus(sample_line_device(cut - 1U)))) {
+		cut = 0U; /* only an in-process slave on the virtual bus can be cut */
+	}
+
+	/* Slaves first, so they are on the bus when the manager resets them. */
+	for (unsigned int i = 0; i < n_slaves; i++) {
+		err = start_slave(i);
+		if (err != 0) {
+			LOG_ERR("slave %u failed to start (%d)", FIRST_SLAVE + i, err);
+			return 1;
+		}
+		printk("manager: slave %u (hello_node) on %s\n", FIRST_SLAVE + i,
+		       slaves[i].line.dev->name);
+	}
+	if (n_slaves == 0U) {
+		printk("manager: no slaves in this process; waiting for nodes 2..5 on the bus\n");
+	}
+	start_us = co_line_time(&mline);
+	err = start_manager((uint8_t)id);
+	if (err != 0) {
+		LOG_ERR("manager failed to start (%d)", err);
+		return 1;
+	}
+	sample_print_stats_on_exit("manager", &mline);
+
+	for (;;) {
+		k_timeout_t wait = next < DEMO_COUNT ? K_TIMEOUT_ABS_MS(done_ms + demo_at_ms[next])
+						     : K_FOREVER;
+
+		if (k_msgq_get(&events, &ev, wait) != 0) {
+			demo((enum demo_action)next, cycle, cut, start_us);
+			next++;
+			continue;
+		}
+		if (ev.kind == EV_STARTUP) {
+			double ms = (double)(ev.t_us - start_us) / 1e3;
+
+			print_table();
+			if (ev.status == CO_MGR_STARTUP_DONE) {
+				printk("manager: NMT startup DONE in %.1f ms, manager %s\n", ms,
+				       co_nmt_state_str(co_nmt_get_state(&mgr)));
+			} else {
+				char det[160];
+
+				error_str(&ev.err, det, sizeof(det));
+				printk("manager: NMT startup HALTED after %.1f ms: node %u failed "
+				       "with %c (%s)\n",
+				       ms, ev.err.node_id, ev.err.status, det);
+			}
+			live = true;
+			done_ms = k_uptime_get();
+			next = 0;
+			continue;
+		}
+		if (live) {
+			print_event(&ev, start_us);
+		}
+		if (atomic_get(&events_lost) != 0) {
+			printk("manager: %ld events lost (queue full)\n",
+			       (long)atomic_set(&events_lost, 0));
+		}
+	}
+	return 0;
+}
