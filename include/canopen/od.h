@@ -262,6 +262,21 @@ typedef uint32_t (*co_od_validate_cb)(struct co_od *od, struct co_od_req *req, v
 typedef void (*co_od_notify_cb)(struct co_od *od, const struct co_od_req *req, void *user_data);
 
 /**
+ * @brief Read-check hook: decide whether a read by an SDO, PDO, SRDO or MPDO reader may
+ * happen (application and storage reads are not checked).
+ *
+ * Runs in the caller's thread with the node's mutex held; must not block.
+ *
+ * @retval 0 allow the read
+ * @retval abort code refuse it (e.g. CO_SDO_AB_NO_DATA for an entry beyond a count)
+ */
+typedef uint32_t (*co_od_read_check_cb)(const struct co_od *od, const struct co_od_info *info,
+					enum co_od_writer reader, void *user_data);
+
+/** Defined when struct co_od_hook has read_check. */
+#define CO_OD_HOOK_READ_CHECK 1
+
+/**
  * @brief A hook on a range of indexes and sub-indexes.
  *
  * Either callback may be NULL. Several hooks may cover the same sub-index: every validate
@@ -275,6 +290,8 @@ struct co_od_hook {
 	co_od_validate_cb validate;
 	co_od_notify_cb notify;
 	void *user_data;
+	/** Optional read check (NULL: none); last so that positional initialisers stay valid. */
+	co_od_read_check_cb read_check;
 };
 
 /**
@@ -349,7 +366,16 @@ struct co_od {
 	co_od_restore_cb restore;
 	void *restore_user_data;
 	const struct co_od_xfer *scratch_owner;
-	struct co_od_hook hooks[CO_OD_HOOKS_MAX];               /**< sorted by index_first */
+	struct co_od_hook hooks[CO_OD_HOOKS_MAX]; /**< sorted by index_first */
+	/** registration number of each hook: (index_first, seq) orders the table */
+	uint32_t hook_seq[CO_OD_HOOKS_MAX];
+	uint32_t hook_next_seq; /**< registration number of the next hook */
+	/**
+	 * Bumped by every hook registration and removal: a hook loop that called out re-finds
+	 * its place when it changed, and caches of "which hooks cover this object" (PDO) are
+	 * stale when it differs from the value they were made with.
+	 */
+	uint32_t hook_gen;
 	const struct co_od_provider *prov[CO_OD_PROVIDERS_MAX]; /**< sorted by index_first */
 	/** staging for chunked writes of values over 8 bytes (validate, then commit) */
 	uint8_t scratch[CO_OD_SCRATCH_SIZE] __attribute__((aligned(8)));
@@ -431,6 +457,10 @@ int co_od_set_restore_cb(struct co_od *od, co_od_restore_cb cb, void *user_data)
 
 /**
  * @brief Register a hook (copied into the instance).
+ *
+ * May be called from inside a hook: the running write still calls every hook that was
+ * registered when its hook loop started and is still registered, each once; the new hook
+ * takes part from the next write on. co_od_hook_unregister() likewise.
  *
  * @retval 0 success
  * @retval -EINVAL bad ranges or both callbacks NULL
@@ -521,6 +551,52 @@ uint32_t co_od_read(const struct co_od *od, uint16_t index, uint8_t sub, uint32_
  */
 uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const void *data,
 			  size_t len, enum co_od_writer writer);
+
+/**
+ * @name Cached access for hot paths (PDO)
+ *
+ * A service that keeps a struct co_od_info (a compiled PDO mapping) may keep a
+ * struct co_od_cover beside it: which hooks cover the object and whether its value can be
+ * moved directly. It is made at first use and made again whenever the hook table changed
+ * (co_od.hook_gen), so a write or read through it behaves exactly as co_od_write_info() /
+ * co_od_read_info() (same checks, hooks and abort codes) without scanning the hook table
+ * for objects no hook covers.
+ * @{
+ */
+/** @cond INTERNAL_HIDDEN */
+#define CO_OD_COVER_MADE       0x01U /* made for hook_gen == gen */
+#define CO_OD_COVER_VALIDATE   0x02U /* a validate hook covers the object */
+#define CO_OD_COVER_NOTIFY     0x04U /* a notify hook covers the object */
+#define CO_OD_COVER_READ_CHECK 0x08U /* a read-check hook covers the object */
+#define CO_OD_COVER_DIRECT     0x10U /* RAM value of a fixed-size type */
+#define CO_OD_COVER_CHECK      0x20U /* limits or BOOLEAN: check the value */
+#define CO_OD_COVER_COPY       0x40U /* the C storage is the wire format (memcpy) */
+/** @endcond */
+
+/** @brief Hook coverage of one object; zero-initialise, then leave to the accessors. */
+struct co_od_cover {
+	uint32_t gen;   /**< co_od.hook_gen when made */
+	uint16_t first; /**< position of the first hook covering the object */
+	uint16_t end;   /**< one past the last hook covering it */
+	uint8_t flags;  /**< CO_OD_COVER_* */
+};
+
+/**
+ * @brief co_od_write_info() of a whole value, using (and refreshing) @p cover.
+ * @return as co_od_write_info()
+ */
+uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
+			    struct co_od_cover *cover, const void *data, size_t len,
+			    enum co_od_writer writer);
+
+/**
+ * @brief co_od_read_info() from offset 0, using (and refreshing) @p cover.
+ * @return as co_od_read_info()
+ */
+uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
+			   struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
+			   enum co_od_writer reader);
+/** @} */
 
 /** @brief co_od_find() then co_od_write_info(). */
 uint32_t co_od_write(struct co_od *od, uint16_t index, uint8_t sub, const void *data, size_t len,

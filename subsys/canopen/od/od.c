@@ -512,10 +512,13 @@ int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 
 	while (pos > 0U && od->hooks[pos - 1U].index_first > hook->index_first) {
 		od->hooks[pos] = od->hooks[pos - 1U];
+		od->hook_seq[pos] = od->hook_seq[pos - 1U];
 		pos--;
 	}
 	od->hooks[pos] = *hook;
+	od->hook_seq[pos] = od->hook_next_seq++;
 	od->n_hooks++;
+	od->hook_gen++;
 	uint16_t span = hook->index_last - hook->index_first;
 
 	if (span > od->hook_span) {
@@ -536,6 +539,7 @@ int co_od_hook_unregister(struct co_od *od, const void *user_data)
 			continue;
 		}
 		od->hooks[w] = od->hooks[r];
+		od->hook_seq[w] = od->hook_seq[r];
 		uint16_t span = od->hooks[w].index_last - od->hooks[w].index_first;
 
 		if (span > od->hook_span) {
@@ -544,6 +548,9 @@ int co_od_hook_unregister(struct co_od *od, const void *user_data)
 		w++;
 	}
 	od->n_hooks = w;
+	if (removed > 0) {
+		od->hook_gen++;
+	}
 	return removed;
 }
 
@@ -572,19 +579,59 @@ static bool hook_covers(const struct co_od_hook *h, uint16_t index, uint8_t sub)
 	       sub <= h->sub_last;
 }
 
-static uint32_t run_validate(struct co_od *od, const struct co_od_req *req)
+/*
+ * Position of the first hook after the one that was at (first, seq), whether that one is
+ * still registered or not: the table is ordered by (index_first, registration number).
+ */
+static uint16_t hooks_after(const struct co_od *od, uint16_t first, uint32_t seq)
+{
+	uint16_t lo = 0;
+	uint16_t hi = od->n_hooks;
+
+	while (lo < hi) {
+		uint16_t mid = lo + (hi - lo) / 2U;
+
+		if (od->hooks[mid].index_first < first) {
+			lo = mid + 1U;
+		} else {
+			hi = mid;
+		}
+	}
+	while (lo < od->n_hooks && od->hooks[lo].index_first == first && od->hook_seq[lo] <= seq) {
+		lo++;
+	}
+	return lo;
+}
+
+/*
+ * A hook may register or unregister hooks (the PDO service re-hooks its mapped objects when
+ * a mapping is written), which moves the table under the loop. The loops below therefore
+ * re-find their place when the generation changed, and only call hooks registered before
+ * the loop started: every hook present throughout runs exactly once, a removed one no more.
+ */
+/*
+ * The loops start at @p i; @p end bounds them while the table is unchanged (a cached
+ * coverage, struct co_od_cover), UINT16_MAX otherwise.
+ */
+static uint32_t run_validate_at(struct co_od *od, const struct co_od_req *req, uint16_t i,
+				uint16_t end)
 {
 	uint16_t index = req->info->index;
 	uint32_t result = 0;
+	uint32_t gen = od->hook_gen;
+	uint32_t limit = od->hook_next_seq;
 
-	for (uint16_t i = hooks_start(od, index);
-	     i < od->n_hooks && od->hooks[i].index_first <= index; i++) {
+	while (i < od->n_hooks && i < end && od->hooks[i].index_first <= index) {
 		const struct co_od_hook *h = &od->hooks[i];
 
-		if (h->validate == NULL || !hook_covers(h, index, req->info->sub)) {
+		if (h->validate == NULL || od->hook_seq[i] >= limit ||
+		    !hook_covers(h, index, req->info->sub)) {
+			i++;
 			continue;
 		}
 		struct co_od_req copy = *req;
+		uint16_t first = h->index_first;
+		uint32_t seq = od->hook_seq[i];
 		uint32_t r = h->validate(od, &copy, h->user_data);
 
 		if (r == CO_OD_HANDLED) {
@@ -592,22 +639,53 @@ static uint32_t run_validate(struct co_od *od, const struct co_od_req *req)
 		} else if (r != 0U) {
 			return r;
 		}
+		if (od->hook_gen != gen) {
+			gen = od->hook_gen;
+			i = hooks_after(od, first, seq);
+			end = UINT16_MAX;
+		} else {
+			i++;
+		}
 	}
 	return result;
 }
 
-static void run_notify(struct co_od *od, const struct co_od_req *req)
+static uint32_t run_validate(struct co_od *od, const struct co_od_req *req)
+{
+	return run_validate_at(od, req, hooks_start(od, req->info->index), UINT16_MAX);
+}
+
+static void run_notify_at(struct co_od *od, const struct co_od_req *req, uint16_t i, uint16_t end)
 {
 	uint16_t index = req->info->index;
+	uint32_t gen = od->hook_gen;
+	uint32_t limit = od->hook_next_seq;
 
-	for (uint16_t i = hooks_start(od, index);
-	     i < od->n_hooks && od->hooks[i].index_first <= index; i++) {
+	while (i < od->n_hooks && i < end && od->hooks[i].index_first <= index) {
 		const struct co_od_hook *h = &od->hooks[i];
 
-		if (h->notify != NULL && hook_covers(h, index, req->info->sub)) {
-			h->notify(od, req, h->user_data);
+		if (h->notify == NULL || od->hook_seq[i] >= limit ||
+		    !hook_covers(h, index, req->info->sub)) {
+			i++;
+			continue;
+		}
+		uint16_t first = h->index_first;
+		uint32_t seq = od->hook_seq[i];
+
+		h->notify(od, req, h->user_data);
+		if (od->hook_gen != gen) {
+			gen = od->hook_gen;
+			i = hooks_after(od, first, seq);
+			end = UINT16_MAX;
+		} else {
+			i++;
 		}
 	}
+}
+
+static void run_notify(struct co_od *od, const struct co_od_req *req)
+{
+	run_notify_at(od, req, hooks_start(od, req->info->index), UINT16_MAX);
 }
 
 int co_od_provider_register(struct co_od *od, const struct co_od_provider *p)
@@ -768,12 +846,44 @@ static uint32_t check_read(const struct co_od_info *info, enum co_od_writer read
 	}
 }
 
+static uint32_t run_read_check_at(const struct co_od *od, const struct co_od_info *info,
+				  enum co_od_writer reader, uint16_t i, uint16_t end)
+{
+	uint16_t index = info->index;
+
+	if (reader == CO_OD_WRITER_APP || reader == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	for (; i < od->n_hooks && i < end && od->hooks[i].index_first <= index; i++) {
+		const struct co_od_hook *h = &od->hooks[i];
+
+		if (h->read_check == NULL || !hook_covers(h, index, info->sub)) {
+			continue;
+		}
+		uint32_t r = h->read_check(od, info, reader, h->user_data);
+
+		if (r != 0U) {
+			return r;
+		}
+	}
+	return 0U;
+}
+
+static uint32_t run_read_check(const struct co_od *od, const struct co_od_info *info,
+			       enum co_od_writer reader)
+{
+	return run_read_check_at(od, info, reader, hooks_start(od, info->index), UINT16_MAX);
+}
+
 uint32_t co_od_read_info(const struct co_od *od, const struct co_od_info *info, uint32_t offset,
 			 void *buf, size_t cap, size_t *len, enum co_od_writer reader)
 {
 	uint32_t ab = check_read(info, reader);
 
 	*len = 0;
+	if (ab == 0U) {
+		ab = run_read_check(od, info, reader);
+	}
 	if (ab != 0U) {
 		return ab;
 	}
@@ -941,6 +1051,165 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 		return 0U;
 	}
 	return finish_write(od, info, data, len, writer);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Cached access (hot paths) */
+
+/* Whether the C storage of a fixed-size type holds its wire bytes as they are. */
+static bool wire_is_storage(uint8_t dtype)
+{
+	uint32_t size = co_dtype_size(dtype);
+	enum co_dtype_class cls = co_dtype_class(dtype);
+
+	if (__BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__ || size != co_od_csize(dtype)) {
+		return false;
+	}
+	return cls == CO_DTYPE_CLASS_UINT || cls == CO_DTYPE_CLASS_INT ||
+	       cls == CO_DTYPE_CLASS_REAL || cls == CO_DTYPE_CLASS_BOOL;
+}
+
+/* memcpy() of a fixed-size value with constant lengths, which compilers inline. */
+static inline void copy_fixed(void *dst, const void *src, uint32_t size)
+{
+	switch (size) {
+	case 1:
+		memcpy(dst, src, 1);
+		break;
+	case 2:
+		memcpy(dst, src, 2);
+		break;
+	case 4:
+		memcpy(dst, src, 4);
+		break;
+	case 8:
+		memcpy(dst, src, 8);
+		break;
+	default:
+		memcpy(dst, src, size);
+		break;
+	}
+}
+
+static void cover_make(const struct co_od *od, const struct co_od_info *info,
+		       struct co_od_cover *cover)
+{
+	uint16_t index = info->index;
+	uint8_t flags = CO_OD_COVER_MADE;
+
+	cover->first = UINT16_MAX;
+	cover->end = 0U;
+	for (uint16_t i = hooks_start(od, index);
+	     i < od->n_hooks && od->hooks[i].index_first <= index; i++) {
+		const struct co_od_hook *h = &od->hooks[i];
+
+		if (!hook_covers(h, index, info->sub)) {
+			continue;
+		}
+		if (cover->first == UINT16_MAX) {
+			cover->first = i;
+		}
+		cover->end = i + 1U;
+		flags |= (h->validate != NULL ? CO_OD_COVER_VALIDATE : 0U) |
+			 (h->notify != NULL ? CO_OD_COVER_NOTIFY : 0U) |
+			 (h->read_check != NULL ? CO_OD_COVER_READ_CHECK : 0U);
+	}
+	if (info->prov == NULL && (info->flags & CO_OD_F_ROM) == 0U &&
+	    co_dtype_size(info->dtype) != 0U && info->size == co_dtype_size(info->dtype) &&
+	    has_storage(info->desc)) {
+		flags |= CO_OD_COVER_DIRECT;
+		if (info->limit != NULL || co_dtype_class(info->dtype) == CO_DTYPE_CLASS_BOOL) {
+			flags |= CO_OD_COVER_CHECK;
+		}
+		if (wire_is_storage(info->dtype)) {
+			flags |= CO_OD_COVER_COPY;
+		}
+	}
+	cover->flags = flags;
+	cover->gen = od->hook_gen;
+}
+
+static inline void cover_refresh(const struct co_od *od, const struct co_od_info *info,
+				 struct co_od_cover *cover)
+{
+	if ((cover->flags & CO_OD_COVER_MADE) == 0U || cover->gen != od->hook_gen) {
+		cover_make(od, info, cover);
+	}
+}
+
+uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
+			    struct co_od_cover *cover, const void *data, size_t len,
+			    enum co_od_writer writer)
+{
+	cover_refresh(od, info, cover);
+	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || len != info->size) {
+		return co_od_write_info(od, info, data, len, writer);
+	}
+	/* finish_write() of a fixed-size RAM value, the hook scans limited to the cover. */
+	uint32_t ab = check_access(info, writer);
+
+	if (ab == 0U && (cover->flags & CO_OD_COVER_CHECK) != 0U) {
+		ab = check_value(od, info, data);
+	}
+	if (ab != 0U) {
+		return ab;
+	}
+	struct co_od_req req = {.info = info, .writer = writer, .data = data, .len = len};
+	uint32_t gen = od->hook_gen;
+
+	if ((cover->flags & CO_OD_COVER_VALIDATE) != 0U) {
+		ab = run_validate_at(od, &req, cover->first, cover->end);
+		if (ab != 0U && ab != CO_OD_HANDLED) {
+			return ab;
+		}
+	}
+	if (ab == 0U) {
+		uint8_t *mem = od->ram + info->desc->offset;
+
+		if ((cover->flags & CO_OD_COVER_COPY) != 0U) {
+			copy_fixed(mem, data, info->size);
+		} else {
+			decode_fixed(info->dtype, data, mem);
+		}
+	}
+	if (od->hook_gen != gen) {
+		/* A validate hook changed the table: the cover is stale. */
+		run_notify(od, &req);
+	} else if ((cover->flags & CO_OD_COVER_NOTIFY) != 0U) {
+		run_notify_at(od, &req, cover->first, cover->end);
+	}
+	return 0U;
+}
+
+uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
+			   struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
+			   enum co_od_writer reader)
+{
+	cover_refresh(od, info, cover);
+	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || cap < info->size) {
+		return co_od_read_info(od, info, 0, buf, cap, len, reader);
+	}
+	uint32_t ab = check_read(info, reader);
+
+	*len = 0;
+	if (ab == 0U && (cover->flags & CO_OD_COVER_READ_CHECK) != 0U) {
+		ab = run_read_check_at(od, info, reader, cover->first, cover->end);
+	}
+	if (ab != 0U) {
+		return ab;
+	}
+	const uint8_t *mem = od->ram + info->desc->offset;
+
+	if ((cover->flags & CO_OD_COVER_COPY) != 0U) {
+		copy_fixed(buf, mem, info->size);
+	} else {
+		uint8_t tmp[8];
+
+		co_od_encode_fixed(info->dtype, mem, tmp);
+		memcpy(buf, tmp, info->size);
+	}
+	*len = info->size;
+	return 0U;
 }
 
 uint32_t co_od_write(struct co_od *od, uint16_t index, uint8_t sub, const void *data, size_t len,

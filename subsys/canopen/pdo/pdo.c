@@ -1,0 +1,1125 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * PDO service (CiA 301 §7.2.2): RPDOs and TPDOs configured by 1400h-1BFFh. Writes to those
+ * objects are checked by validate hooks and applied by notify hooks at once; the mapping is
+ * compiled into a table of resolved objects when sub-index 0 of a mapping record is written.
+ *
+ * Decisions (doc/pdo.md):
+ * - A change that the PDO's present state forbids (CAN-ID, inhibit time, SYNC start value or
+ *   mapping while the PDO is valid; mapping entries while sub 0 != 0) is refused with
+ *   06090030h. Mapping writes in Operational: 08000022h unless
+ *   CONFIG_CANOPEN_PDO_REMAP_IN_OPERATIONAL.
+ * - The inhibit time applies to every transmission type. A transmission that falls into it
+ *   is remembered and made once when it ends; a synchronous sample that would then leave the
+ *   SYNC window (1007h) is dropped.
+ * - The SYNC whose counter equals the SYNC start value counts as the first SYNC; a cyclic
+ *   TPDO of type n is sent at the n-th SYNC counted from there. Without a start value the
+ *   first SYNC in Operational counts as the first.
+ * - An RPDO longer than its mapping is processed and raises EMCY 8220h; a shorter one is
+ *   dropped and raises 8210h; a frame of the mapped length clears both. The deadline monitor
+ *   (event timer) arms at the first reception and raises 8250h, cleared at the next frame.
+ * - Change of state: every committed write (except storage restores) to an object mapped
+ *   into a valid TPDO of type 0, 254 or 255 is an event. Each mapped object takes one OD
+ *   hook while the TPDO has such a type.
+ * - MPDOs (mapping sub 0 FEh/FFh, mpdo.c) need type 254/255 (06090030h otherwise, for the
+ *   mapping and for the type); they have no event timer, no RTR and no change of state. An
+ *   MPDO shorter than 8 bytes is a length error (8210h) as for any RPDO; a DAM-MPDO to a
+ *   missing object raises 8230h, cleared by the next DAM-MPDO written.
+ */
+
+#include <errno.h>
+#include <string.h>
+
+#include <zephyr/kernel.h>
+#include <zephyr/logging/log.h>
+
+#include <canopen/node.h>
+#include <canopen/pdo.h>
+
+#include "node_internal.h"
+#include "pdo_internal.h"
+
+LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
+
+#define IDX_RPDO_COMM 0x1400U
+#define IDX_RPDO_MAP  0x1600U
+#define IDX_TPDO_COMM 0x1800U
+#define IDX_TPDO_MAP  0x1A00U
+
+#define SUB_COB_ID     1U
+#define SUB_TYPE       2U
+#define SUB_INHIBIT    3U
+#define SUB_EVENT      5U
+#define SUB_SYNC_START 6U
+
+#define MAP_SAM_MPDO CO_MPDO_SAM
+#define MAP_DAM_MPDO CO_MPDO_DAM
+#define MAP_MAX      64U
+
+#define EMCY_PDO_LENGTH     0x8210U
+#define EMCY_PDO_LENGTH_EXC 0x8220U
+#define EMCY_RPDO_TIMEOUT   0x8250U
+#define EMCY_DAM_MISSING    0x8230U
+
+#define ERR_SHORT   BIT(0)
+#define ERR_LONG    BIT(1)
+#define ERR_TIMEOUT BIT(2)
+#define ERR_DAM     BIT(3)
+
+/* A change the PDO's present state forbids (CiA 301 §7.5.2.35-38). */
+#define AB_PDO_STATE CO_SDO_AB_INVALID_VALUE
+
+#define CAN_ID_STD 0x7FFU
+#define CAN_ID_EXT 0x1FFFFFFFU
+
+/* --- Helpers ------------------------------------------------------------------------------ */
+
+static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint64_t dflt)
+{
+	uint8_t buf[8] = {0};
+	size_t len = 0;
+
+	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
+		return dflt;
+	}
+	return co_od_le_get(buf, len);
+}
+
+static bool cob_valid(uint32_t cob)
+{
+	return (cob & CO_PDO_COB_INVALID) == 0U;
+}
+
+static uint32_t cob_can_id(uint32_t cob)
+{
+	return (cob & CO_PDO_COB_FRAME) != 0U ? (cob & CAN_ID_EXT) : (cob & CAN_ID_STD);
+}
+
+/* CAN-IDs CiA 301 §7.3.5 reserves for other services. */
+static bool restricted_id(uint32_t id)
+{
+	return id == 0U || id <= 0x07FU || (id >= 0x101U && id <= 0x180U) ||
+	       (id >= 0x581U && id <= 0x5FFU) || (id >= 0x601U && id <= 0x67FU) ||
+	       (id >= 0x6E0U && id <= 0x6FFU) || id >= 0x701U;
+}
+
+static bool is_sync_type(uint8_t type)
+{
+	return type <= CO_PDO_TT_SYNC_MAX;
+}
+
+static bool is_event_type(uint8_t type)
+{
+	return type == CO_PDO_TT_EVENT_MANUF || type == CO_PDO_TT_EVENT_PROF;
+}
+
+static bool is_rtr_type(uint8_t type)
+{
+	return type == CO_PDO_TT_RTR_SYNC || type == CO_PDO_TT_RTR_EVENT;
+}
+
+static bool is_mpdo_map(uint64_t n)
+{
+	return n == MAP_SAM_MPDO || n == MAP_DAM_MPDO;
+}
+
+/* Types that react to application events and changes of state. */
+static bool uses_events(uint8_t type)
+{
+	return type == CO_PDO_TT_SYNC_ACYCLIC || is_event_type(type);
+}
+
+static bool before(uint64_t a, uint64_t b)
+{
+	return !co_time_before_eq(b, a);
+}
+
+static struct co_rpdo *rpdo_of(struct co_node *node, uint16_t index, uint16_t base)
+{
+	uint16_t num = index - base;
+
+	if (num >= CO_RPDOS || !node->pdo.rpdo[num].present) {
+		return NULL;
+	}
+	return &node->pdo.rpdo[num];
+}
+
+static struct co_tpdo *tpdo_of(struct co_node *node, uint16_t index, uint16_t base)
+{
+	uint16_t num = index - base;
+
+	if (num >= CO_TPDOS || !node->pdo.tpdo[num].present) {
+		return NULL;
+	}
+	return &node->pdo.tpdo[num];
+}
+
+/*
+ * Check (out == NULL) or compile the first n entries of a mapping record. The abort codes
+ * are those of CiA 301 §7.5.2.36 step 4.
+ */
+static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n,
+			  struct co_pdo_map *out, uint8_t *runs)
+{
+	uint16_t index = (rx ? IDX_RPDO_MAP : IDX_TPDO_MAP) + num;
+	struct co_pdo_map_ent ent;
+	struct co_pdo_map_ent prev = {0};
+	unsigned int total = 0;
+	bool bytewise = true;
+
+	*runs = 0U;
+
+	if (out != NULL) {
+		out->n = 0U;
+		out->bits = 0U;
+		out->bytewise = true;
+	}
+	if (n > CO_PDO_MAP_ENTRIES) {
+		return CO_SDO_AB_MAP_LEN;
+	}
+	for (uint8_t i = 1; i <= n; i++) {
+		uint8_t buf[4] = {0};
+		size_t len = 0;
+
+		/* A record with fewer entries than sub 0 asks for: too many objects. */
+		if (co_od_read(&node->od, index, i, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) !=
+		    0U) {
+			return CO_SDO_AB_MAP_LEN;
+		}
+		uint32_t ab =
+			co_pdo_map_check(&node->od, rx, (uint32_t)co_od_le_get(buf, len), &ent);
+
+		if (ab != 0U) {
+			return ab;
+		}
+		total += ent.bits;
+		if (total > CO_PDO_MAX_BITS) {
+			return CO_SDO_AB_MAP_LEN;
+		}
+		if (ent.bits % 8U != 0U) {
+			bytewise = false;
+		}
+		/* Consecutive sub-indexes of one object share a change-of-state hook. */
+		if (i == 1U || prev.info.index != ent.info.index ||
+		    prev.info.sub + 1U != ent.info.sub) {
+			(*runs)++;
+		}
+		prev = ent;
+		if (out != NULL) {
+			out->ent[i - 1U] = ent;
+		}
+	}
+	if (out != NULL) {
+		out->n = n;
+		out->bits = (uint8_t)total;
+		out->bytewise = bytewise;
+	}
+	return 0U;
+}
+
+/* --- EMCY of RPDOs ------------------------------------------------------------------------ */
+
+static void rpdo_error(struct co_rpdo *r, uint8_t bit, bool on)
+{
+	if (((r->errors & bit) != 0U) == on) {
+		return;
+	}
+	r->errors ^= bit;
+#if defined(CONFIG_CANOPEN_EMCY)
+	struct co_node *node = r->node;
+	uint16_t code = bit == ERR_SHORT  ? EMCY_PDO_LENGTH
+			: bit == ERR_LONG ? EMCY_PDO_LENGTH_EXC
+			: bit == ERR_DAM  ? EMCY_DAM_MISSING
+					  : EMCY_RPDO_TIMEOUT;
+
+	if (on) {
+		co_emcy_raise_internal(node, code, CO_EMCY_REG_COMMUNICATION);
+		return;
+	}
+	/* The code stays active while any other RPDO still has the same fault. */
+	for (int i = 0; i < CO_RPDOS; i++) {
+		if ((node->pdo.rpdo[i].errors & bit) != 0U) {
+			return;
+		}
+	}
+	co_emcy_clear_internal(node, code);
+#endif
+}
+
+/* --- RPDO --------------------------------------------------------------------------------- */
+
+static void rpdo_indicate(struct co_rpdo *r)
+{
+	struct co_pdo *pdo = &r->node->pdo;
+
+	if (pdo->rpdo_ind != NULL) {
+		pdo->rpdo_ind(r->node, r->num, pdo->rpdo_ind_user_data);
+	}
+}
+
+/* A received MPDO (DLC 8): the object side is in mpdo.c. */
+static void rpdo_mpdo(struct co_rpdo *r, const struct can_frame *frame)
+{
+#if defined(CONFIG_CANOPEN_MPDO)
+	switch (co_mpdo_rx(r->node, r->mpdo, frame->data)) {
+	case CO_MPDO_RX_WRITTEN:
+		if (r->mpdo == MAP_DAM_MPDO) {
+			rpdo_error(r, ERR_DAM, false);
+		}
+		rpdo_indicate(r);
+		break;
+	case CO_MPDO_RX_MISSING:
+		rpdo_error(r, ERR_DAM, true);
+		break;
+	default:
+		break;
+	}
+#endif
+}
+
+static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_rpdo *r = rx->user_data;
+	struct co_node *node = r->node;
+	struct co_pdo *pdo = &node->pdo;
+	/* An MPDO always has 8 bytes (CiA 301 §7.2.3). */
+	uint8_t mapped = r->mpdo != 0U ? 8U : (uint8_t)((r->map.bits + 7U) / 8U);
+
+	if ((frame->flags & CAN_FRAME_RTR) != 0U || !pdo->operational || !cob_valid(r->cob_id)) {
+		return;
+	}
+	if (frame->dlc < mapped) {
+		rpdo_error(r, ERR_SHORT, true);
+		return;
+	}
+	rpdo_error(r, ERR_SHORT, false);
+	rpdo_error(r, ERR_LONG, frame->dlc > mapped);
+	if (r->event_ms != 0U) {
+		co_timer_start(node->line, &r->timer, now_us + (uint64_t)r->event_ms * 1000U);
+		rpdo_error(r, ERR_TIMEOUT, false);
+	}
+	if (r->mpdo != 0U) {
+		rpdo_mpdo(r, frame);
+		return;
+	}
+	if (is_sync_type(r->type)) {
+		/* Outside the SYNC window the frame belongs to no SYNC (CiA 301 §7.5.2.7). */
+		if (pdo->window && before(pdo->window_end, now_us)) {
+			return;
+		}
+		memcpy(r->sync_data, frame->data, mapped);
+		r->sync_dlc = mapped;
+		r->sync_pending = true;
+		return;
+	}
+	(void)co_pdo_map_unpack(&node->od, &r->map, frame->data);
+	rpdo_indicate(r);
+}
+
+static void rpdo_timeout(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_rpdo *r = timer->user_data;
+
+	if (r->node->pdo.operational && cob_valid(r->cob_id) && r->event_ms != 0U) {
+		rpdo_error(r, ERR_TIMEOUT, true);
+	}
+}
+
+static void rpdo_configure(struct co_rpdo *r)
+{
+	struct co_node *node = r->node;
+
+	co_timer_stop(&r->timer);
+	r->sync_pending = false;
+	co_rx_unregister(&r->rx);
+	if (!cob_valid(r->cob_id)) {
+		rpdo_error(r, ERR_SHORT, false);
+		rpdo_error(r, ERR_LONG, false);
+		rpdo_error(r, ERR_TIMEOUT, false);
+		rpdo_error(r, ERR_DAM, false);
+		return;
+	}
+	r->rx.ext = (r->cob_id & CO_PDO_COB_FRAME) != 0U;
+	r->rx.mask = r->rx.ext ? CAN_ID_EXT : CAN_ID_STD;
+	if (co_rx_set_id(node->line, &r->rx, cob_can_id(r->cob_id)) != 0) {
+		LOG_ERR("%s: no receive slot for RPDO %u", node->name, r->num);
+	}
+}
+
+/* --- TPDO --------------------------------------------------------------------------------- */
+
+static void tpdo_sample(struct co_tpdo *t)
+{
+	struct co_pdo *pdo = &t->node->pdo;
+
+	if (pdo->tpdo_ind != NULL) {
+		t->sampling = true;
+		pdo->tpdo_ind(t->node, t->num, pdo->tpdo_ind_user_data);
+		t->sampling = false;
+	}
+	t->dlc = co_pdo_map_pack(&t->node->od, &t->map, t->buf);
+}
+
+static bool tpdo_inhibited(const struct co_tpdo *t, uint64_t now)
+{
+	return t->inhibit_us != 0U && before(now, t->inhibit_end);
+}
+
+static void tpdo_event_timer_restart(struct co_tpdo *t, uint64_t now)
+{
+	co_timer_stop(&t->event_timer);
+	if (t->node->pdo.operational && cob_valid(t->cob_id) && is_event_type(t->type) &&
+	    t->event_ms != 0U && t->mpdo == 0U) {
+		co_timer_start(t->node->line, &t->event_timer, now + (uint64_t)t->event_ms * 1000U);
+	}
+}
+
+/* Send the sample in buf now. */
+static void tpdo_transmit(struct co_tpdo *t, uint64_t now)
+{
+	struct can_frame f = {
+		.id = cob_can_id(t->cob_id),
+		.dlc = t->dlc,
+		.flags = (t->cob_id & CO_PDO_COB_FRAME) != 0U ? CAN_FRAME_IDE : 0U,
+	};
+
+	memcpy(f.data, t->buf, sizeof(t->buf));
+	(void)co_node_send(t->node, &f);
+	t->deferred = false;
+	t->inhibit_end = now + t->inhibit_us;
+	if (is_event_type(t->type)) {
+		tpdo_event_timer_restart(t, now);
+	}
+}
+
+static void tpdo_defer(struct co_tpdo *t)
+{
+	if (!co_timer_is_armed(&t->inhibit_timer)) {
+		co_timer_start(t->node->line, &t->inhibit_timer, t->inhibit_end);
+	}
+}
+
+/* A synchronous sample is ready in buf: send it, or when the inhibit time ends. */
+static void tpdo_send_sample(struct co_tpdo *t, uint64_t now)
+{
+	if (tpdo_inhibited(t, now)) {
+		t->deferred = true;
+		tpdo_defer(t);
+		return;
+	}
+	tpdo_transmit(t, now);
+}
+
+/* Event-driven transmission: sample and send now, or once when the inhibit time ends. */
+static void tpdo_send_event(struct co_tpdo *t, uint64_t now)
+{
+	if (tpdo_inhibited(t, now)) {
+		t->event = true;
+		tpdo_defer(t);
+		return;
+	}
+	t->event = false;
+	tpdo_sample(t);
+	tpdo_transmit(t, now);
+}
+
+/* An application event, a change of state or a remote request on an event-driven TPDO. */
+static void tpdo_event(struct co_tpdo *t, uint64_t now)
+{
+	if (t->type == CO_PDO_TT_SYNC_ACYCLIC) {
+		t->event = true;
+	} else if (is_event_type(t->type)) {
+		tpdo_send_event(t, now);
+	}
+}
+
+int co_tpdo_mpdo_send(struct co_tpdo *t, const uint8_t data[8])
+{
+	if (t->deferred) {
+		/* One frame waits for the inhibit time already; MPDOs of different objects
+		 * cannot be merged into one.
+		 */
+		return -EBUSY;
+	}
+	memcpy(t->buf, data, sizeof(t->buf));
+	t->dlc = 8U;
+	tpdo_send_sample(t, co_line_time(t->node->line));
+	return 0;
+}
+
+static void tpdo_inhibit_expired(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_tpdo *t = timer->user_data;
+	struct co_pdo *pdo = &t->node->pdo;
+
+	if (!pdo->operational || !cob_valid(t->cob_id)) {
+		return;
+	}
+	if (t->deferred) {
+		/* A sample that missed its SYNC window is stale (CiA 301 §7.5.2.7). */
+		if (is_sync_type(t->type) && pdo->window && before(pdo->window_end, now_us)) {
+			t->deferred = false;
+		} else {
+			tpdo_transmit(t, now_us);
+		}
+	}
+	if (t->event && is_event_type(t->type)) {
+		tpdo_send_event(t, now_us);
+	}
+}
+
+static void tpdo_event_expired(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_tpdo *t = timer->user_data;
+
+	if (t->node->pdo.operational && cob_valid(t->cob_id) && is_event_type(t->type)) {
+		tpdo_send_event(t, now_us);
+	}
+}
+
+static void tpdo_rtr(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_tpdo *t = rx->user_data;
+
+	if ((frame->flags & CAN_FRAME_RTR) == 0U || !t->node->pdo.operational ||
+	    !cob_valid(t->cob_id) || (t->cob_id & CO_PDO_COB_NO_RTR) != 0U || t->mpdo != 0U) {
+		return;
+	}
+	switch (t->type) {
+	case CO_PDO_TT_RTR_SYNC:
+		if (t->sampled) {
+			tpdo_send_sample(t, now_us);
+		}
+		break;
+	case CO_PDO_TT_RTR_EVENT:
+		tpdo_sample(t);
+		tpdo_send_sample(t, now_us);
+		break;
+	default:
+		tpdo_event(t, now_us);
+		break;
+	}
+}
+
+static void tpdo_reset_state(struct co_tpdo *t)
+{
+	co_timer_stop(&t->inhibit_timer);
+	co_timer_stop(&t->event_timer);
+	t->started = false;
+	t->sync_count = 0U;
+	t->event = false;
+	t->deferred = false;
+	t->sampled = false;
+	t->inhibit_end = co_line_time(t->node->line);
+}
+
+static void tpdo_configure(struct co_tpdo *t)
+{
+	struct co_node *node = t->node;
+
+	tpdo_reset_state(t);
+	co_rx_unregister(&t->rx);
+	if (!cob_valid(t->cob_id)) {
+		return;
+	}
+	if (IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) && (t->cob_id & CO_PDO_COB_NO_RTR) == 0U) {
+		t->rx.ext = (t->cob_id & CO_PDO_COB_FRAME) != 0U;
+		t->rx.mask = t->rx.ext ? CAN_ID_EXT : CAN_ID_STD;
+		if (co_rx_set_id(node->line, &t->rx, cob_can_id(t->cob_id)) != 0) {
+			LOG_ERR("%s: no receive slot for TPDO %u RTR", node->name, t->num);
+		}
+	}
+	tpdo_event_timer_restart(t, co_line_time(node->line));
+}
+
+/* --- Change of state ---------------------------------------------------------------------- */
+
+static void cos_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_tpdo *t = user_data;
+
+	if (req->writer == CO_OD_WRITER_STORAGE || t->sampling || !t->node->pdo.operational ||
+	    !cob_valid(t->cob_id)) {
+		return;
+	}
+	tpdo_event(t, co_line_time(t->node->line));
+}
+
+/* Hooks a mapping needs: one per run of consecutive sub-indexes of one object. */
+static uint8_t cos_hooks_needed(const struct co_pdo_map *map, uint8_t type)
+{
+	uint8_t n = 0U;
+
+	if (!uses_events(type)) {
+		return 0U;
+	}
+	for (uint8_t i = 0; i < map->n; i++) {
+		const struct co_od_info *a = &map->ent[i].info;
+		const struct co_od_info *p = i > 0U ? &map->ent[i - 1U].info : NULL;
+
+		if (p == NULL || p->index != a->index || p->sub + 1U != a->sub) {
+			n++;
+		}
+	}
+	return n;
+}
+
+static uint32_t cos_hooks_fit(struct co_node *node, const struct co_tpdo *t,
+			      const struct co_pdo_map *map, uint8_t type)
+{
+	uint32_t free_slots = CO_OD_HOOKS_MAX - node->od.n_hooks + t->n_hooks;
+
+	return cos_hooks_needed(map, type) <= free_slots ? 0U : CO_SDO_AB_DEV_INCOMPAT;
+}
+
+static void cos_hooks_update(struct co_tpdo *t)
+{
+	struct co_od *od = &t->node->od;
+
+	(void)co_od_hook_unregister(od, t);
+	t->n_hooks = 0U;
+	if (!uses_events(t->type)) {
+		return;
+	}
+	for (uint8_t i = 0; i < t->map.n; i++) {
+		const struct co_od_info *a = &t->map.ent[i].info;
+		struct co_od_hook h = {a->index, a->index, a->sub, a->sub, NULL, cos_notify, t};
+
+		while (i + 1U < t->map.n && t->map.ent[i + 1U].info.index == a->index &&
+		       t->map.ent[i + 1U].info.sub == h.sub_last + 1U) {
+			h.sub_last++;
+			i++;
+		}
+		if (co_od_hook_register(od, &h) != 0) {
+			LOG_ERR("%s: no OD hook for change of state of %04Xh", t->node->name,
+				a->index);
+			continue;
+		}
+		t->n_hooks++;
+	}
+}
+
+/* --- SYNC --------------------------------------------------------------------------------- */
+
+static void tpdo_sync(struct co_tpdo *t, uint8_t counter, uint64_t now)
+{
+	if (t->type == CO_PDO_TT_SYNC_ACYCLIC) {
+		if (t->event) {
+			t->event = false;
+			tpdo_sample(t);
+			tpdo_send_sample(t, now);
+		}
+	} else if (t->type <= CO_PDO_TT_SYNC_MAX) {
+		if (!t->started) {
+			/* With a counter and a start value, counting starts at the matching SYNC.
+			 */
+			if (t->sync_start != 0U && counter != 0U && counter != t->sync_start) {
+				return;
+			}
+			t->started = true;
+			t->sync_count = 0U;
+		}
+		if (++t->sync_count >= t->type) {
+			t->sync_count = 0U;
+			tpdo_sample(t);
+			tpdo_send_sample(t, now);
+		}
+	} else if (t->type == CO_PDO_TT_RTR_SYNC) {
+		tpdo_sample(t);
+		t->sampled = true;
+	}
+}
+
+void co_pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uint32_t window_us)
+{
+	struct co_pdo *pdo = &node->pdo;
+
+	if (!pdo->operational) {
+		return;
+	}
+	pdo->window = window_us != 0U;
+	pdo->window_end = now_us + window_us;
+	/* Inputs are sampled before the outputs of this SYNC are applied. */
+	for (int i = 0; i < CO_TPDOS; i++) {
+		struct co_tpdo *t = &pdo->tpdo[i];
+
+		if (t->present && cob_valid(t->cob_id)) {
+			tpdo_sync(t, counter, now_us);
+		}
+	}
+	for (int i = 0; i < CO_RPDOS; i++) {
+		struct co_rpdo *r = &pdo->rpdo[i];
+
+		if (r->present && r->sync_pending && cob_valid(r->cob_id) &&
+		    is_sync_type(r->type)) {
+			r->sync_pending = false;
+			(void)co_pdo_map_unpack(&node->od, &r->map, r->sync_data);
+			rpdo_indicate(r);
+		}
+	}
+}
+
+/* --- Hooks on 1400h-1BFFh ----------------------------------------------------------------- */
+
+static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_rpdo *r = rpdo_of(user_data, req->info->index, IDX_RPDO_COMM);
+	uint64_t v = co_od_req_uint(req);
+
+	if (r == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	switch (req->info->sub) {
+	case SUB_COB_ID:
+		if (cob_valid(r->cob_id) && cob_valid((uint32_t)v) &&
+		    ((v ^ r->cob_id) & ~(uint64_t)CO_PDO_COB_INVALID) != 0U) {
+			return AB_PDO_STATE;
+		}
+		if ((v & CO_PDO_COB_FRAME) == 0U && (v & 0x1FFFF800U) != 0U) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
+		    restricted_id((uint32_t)v & CAN_ID_STD)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		return 0U;
+	case SUB_TYPE:
+		/* 241..253 are reserved for RPDOs (CiA 301 §7.5.2.35). */
+		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_EVENT_MANUF) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		/* MPDOs are event-driven only. */
+		return r->mpdo != 0U && !is_event_type((uint8_t)v) ? AB_PDO_STATE : 0U;
+	default:
+		return 0U;
+	}
+}
+
+static void rpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_rpdo *r = rpdo_of(user_data, req->info->index, IDX_RPDO_COMM);
+	uint64_t v = co_od_req_uint(req);
+
+	if (r == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+		return;
+	}
+	switch (req->info->sub) {
+	case SUB_COB_ID:
+		r->cob_id = (uint32_t)v;
+		rpdo_configure(r);
+		break;
+	case SUB_TYPE:
+		r->type = (uint8_t)v;
+		r->sync_pending = false;
+		break;
+	case SUB_EVENT:
+		r->event_ms = (uint16_t)v;
+		if (r->event_ms == 0U) {
+			co_timer_stop(&r->timer);
+			rpdo_error(r, ERR_TIMEOUT, false);
+		} else if (co_timer_is_armed(&r->timer)) {
+			co_timer_start(r->node->line, &r->timer,
+				       co_line_time(r->node->line) + (uint64_t)r->event_ms * 1000U);
+		}
+		break;
+	default:
+		break;
+	}
+}
+
+static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	struct co_tpdo *t = tpdo_of(node, req->info->index, IDX_TPDO_COMM);
+	uint64_t v = co_od_req_uint(req);
+	bool valid;
+
+	if (t == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	valid = cob_valid(t->cob_id);
+	switch (req->info->sub) {
+	case SUB_COB_ID:
+		if (valid && cob_valid((uint32_t)v) &&
+		    ((v ^ t->cob_id) & ~(uint64_t)CO_PDO_COB_INVALID) != 0U) {
+			return AB_PDO_STATE;
+		}
+		if ((v & CO_PDO_COB_FRAME) == 0U && (v & 0x1FFFF800U) != 0U) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
+		    restricted_id((uint32_t)v & CAN_ID_STD)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		/* An RTR-only TPDO needs remote requests. */
+		if ((v & CO_PDO_COB_NO_RTR) != 0U && is_rtr_type(t->type)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		return 0U;
+	case SUB_TYPE:
+		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_RTR_SYNC) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		if (is_rtr_type((uint8_t)v) && (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) ||
+						(t->cob_id & CO_PDO_COB_NO_RTR) != 0U)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		if (t->mpdo != 0U && !is_event_type((uint8_t)v)) {
+			return AB_PDO_STATE; /* MPDOs are event-driven only */
+		}
+		return cos_hooks_fit(node, t, &t->map, (uint8_t)v);
+	case SUB_INHIBIT:
+		return valid ? AB_PDO_STATE : 0U;
+	case SUB_SYNC_START:
+		if (valid) {
+			return AB_PDO_STATE;
+		}
+		return v > CO_PDO_TT_SYNC_MAX ? CO_SDO_AB_INVALID_VALUE : 0U;
+	default:
+		return 0U;
+	}
+}
+
+static void tpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_tpdo *t = tpdo_of(user_data, req->info->index, IDX_TPDO_COMM);
+	uint64_t v = co_od_req_uint(req);
+
+	if (t == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+		return;
+	}
+	switch (req->info->sub) {
+	case SUB_COB_ID:
+		t->cob_id = (uint32_t)v;
+		tpdo_configure(t);
+		break;
+	case SUB_TYPE: {
+		bool hooks_change = uses_events(t->type) != uses_events((uint8_t)v);
+
+		t->type = (uint8_t)v;
+		/* Re-hook only when needed (od.c copes with changes from inside its loop). */
+		if (hooks_change) {
+			cos_hooks_update(t);
+		}
+		tpdo_configure(t);
+		break;
+	}
+	case SUB_INHIBIT:
+		t->inhibit_us = (uint32_t)v * 100U;
+		break;
+	case SUB_EVENT:
+		t->event_ms = (uint16_t)v;
+		tpdo_event_timer_restart(t, co_line_time(t->node->line));
+		break;
+	case SUB_SYNC_START:
+		t->sync_start = (uint8_t)v;
+		t->started = false;
+		break;
+	default:
+		break;
+	}
+}
+
+static uint32_t map_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint16_t index = req->info->index;
+	bool rx = index < IDX_TPDO_MAP;
+	struct co_rpdo *r = rx ? rpdo_of(node, index, IDX_RPDO_MAP) : NULL;
+	struct co_tpdo *t = rx ? NULL : tpdo_of(node, index, IDX_TPDO_MAP);
+	uint16_t num = rx ? index - IDX_RPDO_MAP : index - IDX_TPDO_MAP;
+	uint64_t v = co_od_req_uint(req);
+
+	if ((r == NULL && t == NULL) || req->writer == CO_OD_WRITER_STORAGE) {
+		return 0U;
+	}
+	if (node->pdo.operational && !IS_ENABLED(CONFIG_CANOPEN_PDO_REMAP_IN_OPERATIONAL)) {
+		return CO_SDO_AB_DATA_DEV_STATE;
+	}
+	if (cob_valid(rx ? r->cob_id : t->cob_id)) {
+		return AB_PDO_STATE;
+	}
+	if (req->info->sub != 0U) {
+		struct co_pdo_map_ent ent;
+
+		/* Entries change only while the mapping is off (sub 0 = 0). */
+		if (od_uint(node, index, 0, 0U) != 0U) {
+			return AB_PDO_STATE;
+		}
+		return v == 0U ? 0U : co_pdo_map_check(&node->od, rx, (uint32_t)v, &ent);
+	}
+	if (is_mpdo_map(v)) {
+		/* MPDOs are event-driven only (CiA 301 §7.2.3). */
+		if (!IS_ENABLED(CONFIG_CANOPEN_MPDO) || !is_event_type(rx ? r->type : t->type)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		return 0U;
+	}
+	if (v > MAP_MAX) {
+		return CO_SDO_AB_MAP_LEN;
+	}
+	uint8_t runs;
+	uint32_t ab = map_build(node, rx, num, (uint8_t)v, NULL, &runs);
+
+	if (ab == 0U && t != NULL && uses_events(t->type) &&
+	    runs > CO_OD_HOOKS_MAX - node->od.n_hooks + t->n_hooks) {
+		/* No OD hook left for change-of-state detection of these objects. */
+		ab = CO_SDO_AB_DEV_INCOMPAT;
+	}
+	return ab;
+}
+
+static void map_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	struct co_node *node = user_data;
+	uint16_t index = req->info->index;
+	bool rx = index < IDX_TPDO_MAP;
+	struct co_rpdo *r = rx ? rpdo_of(node, index, IDX_RPDO_MAP) : NULL;
+	struct co_tpdo *t = rx ? NULL : tpdo_of(node, index, IDX_TPDO_MAP);
+	uint8_t n = (uint8_t)co_od_req_uint(req);
+
+	if ((r == NULL && t == NULL) || req->writer == CO_OD_WRITER_STORAGE ||
+	    req->info->sub != 0U) {
+		return;
+	}
+	uint8_t runs;
+	uint8_t mpdo = is_mpdo_map(n) ? n : 0U;
+
+	/* An MPDO has no compiled mapping: each frame names its object. */
+	if (r != NULL) {
+		r->mpdo = mpdo;
+		(void)map_build(node, true, r->num, mpdo != 0U ? 0U : n, &r->map, &runs);
+		r->sync_pending = false;
+	} else {
+		t->mpdo = mpdo;
+		(void)map_build(node, false, t->num, mpdo != 0U ? 0U : n, &t->map, &runs);
+		t->sampled = false;
+		t->deferred = false;
+		cos_hooks_update(t);
+	}
+}
+
+/* --- Node interface ----------------------------------------------------------------------- */
+
+static bool od_has(struct co_node *node, uint16_t index)
+{
+	struct co_od_info info;
+
+	return co_od_find(&node->od, index, 0, &info) == 0U;
+}
+
+int co_pdo_init(struct co_node *node)
+{
+	struct co_pdo *pdo = &node->pdo;
+	int err = 0;
+
+	for (uint16_t i = 0; i < CO_RPDOS; i++) {
+		struct co_rpdo *r = &pdo->rpdo[i];
+
+		r->node = node;
+		r->num = i;
+		r->present = od_has(node, IDX_RPDO_COMM + i) && od_has(node, IDX_RPDO_MAP + i);
+		r->cob_id = CO_PDO_COB_INVALID;
+		co_rx_init(&r->rx, 0U, rpdo_rx, &node->lock, r);
+		co_timer_init(&r->timer, rpdo_timeout, &node->lock, r);
+	}
+	for (uint16_t i = 0; i < CO_TPDOS; i++) {
+		struct co_tpdo *t = &pdo->tpdo[i];
+
+		t->node = node;
+		t->num = i;
+		t->present = od_has(node, IDX_TPDO_COMM + i) && od_has(node, IDX_TPDO_MAP + i);
+		t->cob_id = CO_PDO_COB_INVALID;
+		co_rx_init(&t->rx, 0U, tpdo_rtr, &node->lock, t);
+		co_timer_init(&t->inhibit_timer, tpdo_inhibit_expired, &node->lock, t);
+		co_timer_init(&t->event_timer, tpdo_event_expired, &node->lock, t);
+	}
+	/* More PDOs in the dictionary than instances: refuse rather than ignore them. */
+	for (uint16_t i = CO_RPDOS; i < 512U; i++) {
+		if (od_has(node, IDX_RPDO_COMM + i) || od_has(node, IDX_RPDO_MAP + i)) {
+			LOG_ERR("%s: RPDO %u in the dictionary, CONFIG_CANOPEN_RPDOS=%d",
+				node->name, i, CO_RPDOS);
+			return -ENOSPC;
+		}
+	}
+	for (uint16_t i = CO_TPDOS; i < 512U; i++) {
+		if (od_has(node, IDX_TPDO_COMM + i) || od_has(node, IDX_TPDO_MAP + i)) {
+			LOG_ERR("%s: TPDO %u in the dictionary, CONFIG_CANOPEN_TPDOS=%d",
+				node->name, i, CO_TPDOS);
+			return -ENOSPC;
+		}
+	}
+	if (CO_RPDOS > 0) {
+		const struct co_od_hook hooks[] = {
+			{IDX_RPDO_COMM, IDX_RPDO_COMM + CO_RPDOS - 1, 1, 6, rpdo_comm_validate,
+			 rpdo_comm_notify, node},
+			{IDX_RPDO_MAP, IDX_RPDO_MAP + CO_RPDOS - 1, 0, MAP_MAX, map_validate,
+			 map_notify, node},
+		};
+
+		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
+	}
+	if (err == 0 && CO_TPDOS > 0) {
+		const struct co_od_hook hooks[] = {
+			{IDX_TPDO_COMM, IDX_TPDO_COMM + CO_TPDOS - 1, 1, 6, tpdo_comm_validate,
+			 tpdo_comm_notify, node},
+			{IDX_TPDO_MAP, IDX_TPDO_MAP + CO_TPDOS - 1, 0, MAP_MAX, map_validate,
+			 map_notify, node},
+		};
+
+		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
+	}
+#if defined(CONFIG_CANOPEN_MPDO)
+	if (err == 0) {
+		err = co_mpdo_init(node);
+	}
+#endif
+	return err;
+}
+
+static uint8_t map_load(struct co_node *node, bool rx, uint16_t num, uint8_t type,
+			struct co_pdo_map *map, uint8_t *mpdo)
+{
+	uint16_t index = (rx ? IDX_RPDO_MAP : IDX_TPDO_MAP) + num;
+	uint8_t n = (uint8_t)od_uint(node, index, 0, 0U);
+	uint8_t runs;
+
+	*mpdo = 0U;
+	if (is_mpdo_map(n) && IS_ENABLED(CONFIG_CANOPEN_MPDO) && is_event_type(type)) {
+		*mpdo = n;
+		n = 0U;
+	}
+	if (n > MAP_MAX || map_build(node, rx, num, n, map, &runs) != 0U) {
+		LOG_ERR("%s: invalid mapping in %04Xh; the PDO stays off", node->name, index);
+		return 1U;
+	}
+	return 0U;
+}
+
+void co_pdo_reset_comm(struct co_node *node)
+{
+	struct co_pdo *pdo = &node->pdo;
+
+	pdo->window = false;
+	for (uint16_t i = 0; i < CO_RPDOS; i++) {
+		struct co_rpdo *r = &pdo->rpdo[i];
+		uint16_t comm = IDX_RPDO_COMM + i;
+
+		if (!r->present) {
+			continue;
+		}
+		r->cob_id = (uint32_t)od_uint(node, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
+		r->type = (uint8_t)od_uint(node, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		r->event_ms = (uint16_t)od_uint(node, comm, SUB_EVENT, 0U);
+		if (map_load(node, true, i, r->type, &r->map, &r->mpdo) != 0U) {
+			r->cob_id |= CO_PDO_COB_INVALID;
+		}
+		rpdo_configure(r);
+	}
+	for (uint16_t i = 0; i < CO_TPDOS; i++) {
+		struct co_tpdo *t = &pdo->tpdo[i];
+		uint16_t comm = IDX_TPDO_COMM + i;
+
+		if (!t->present) {
+			continue;
+		}
+		t->cob_id = (uint32_t)od_uint(node, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
+		t->type = (uint8_t)od_uint(node, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		t->inhibit_us = (uint32_t)od_uint(node, comm, SUB_INHIBIT, 0U) * 100U;
+		t->event_ms = (uint16_t)od_uint(node, comm, SUB_EVENT, 0U);
+		t->sync_start = (uint8_t)od_uint(node, comm, SUB_SYNC_START, 0U);
+		if (map_load(node, false, i, t->type, &t->map, &t->mpdo) != 0U) {
+			t->cob_id |= CO_PDO_COB_INVALID;
+		}
+		cos_hooks_update(t);
+		tpdo_configure(t);
+	}
+}
+
+void co_pdo_set_state(struct co_node *node, enum co_nmt_state to)
+{
+	struct co_pdo *pdo = &node->pdo;
+	bool op = to == CO_NMT_OPERATIONAL;
+
+	if (op == pdo->operational) {
+		return;
+	}
+	pdo->operational = op;
+	pdo->window = false;
+	for (int i = 0; i < CO_RPDOS; i++) {
+		/* The deadline monitor arms again at the first frame. */
+		co_timer_stop(&pdo->rpdo[i].timer);
+		pdo->rpdo[i].sync_pending = false;
+	}
+	for (int i = 0; i < CO_TPDOS; i++) {
+		struct co_tpdo *t = &pdo->tpdo[i];
+
+		if (t->present) {
+			tpdo_reset_state(t);
+			tpdo_event_timer_restart(t, co_line_time(node->line));
+		}
+	}
+}
+
+/* --- API ---------------------------------------------------------------------------------- */
+
+int co_tpdo_send_req(struct co_node *node, uint16_t num)
+{
+	int err = 0;
+
+	if (node == NULL || num >= CO_TPDOS) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	struct co_tpdo *t = &node->pdo.tpdo[num];
+
+	if (!t->present || !cob_valid(t->cob_id)) {
+		err = -EINVAL;
+	} else if (!node->pdo.operational) {
+		err = -ENETDOWN;
+	} else if (!uses_events(t->type) || t->mpdo != 0U) {
+		err = -ENOTSUP;
+	} else {
+		tpdo_event(t, co_line_time(node->line));
+	}
+	co_node_unlock(node);
+	return err;
+}
+
+void co_rpdo_set_ind(struct co_node *node, co_rpdo_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->pdo.rpdo_ind = cb;
+	node->pdo.rpdo_ind_user_data = user_data;
+	co_node_unlock(node);
+}
+
+void co_tpdo_set_ind(struct co_node *node, co_tpdo_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->pdo.tpdo_ind = cb;
+	node->pdo.tpdo_ind_user_data = user_data;
+	co_node_unlock(node);
+}
+
+#if !defined(CONFIG_CANOPEN_MPDO)
+int co_mpdo_dam_req(struct co_node *node, uint16_t num, uint8_t dest_id, uint16_t index,
+		    uint8_t sub, const void *data, size_t len)
+{
+	return -ENOTSUP;
+}
+
+int co_mpdo_sam_req(struct co_node *node, uint16_t num, uint16_t index, uint8_t sub)
+{
+	return -ENOTSUP;
+}
+
+void co_mpdo_get_stats(struct co_node *node, struct co_mpdo_stats *stats)
+{
+	memset(stats, 0, sizeof(*stats));
+}
+#endif

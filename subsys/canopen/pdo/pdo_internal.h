@@ -1,0 +1,95 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * PDO mapping: entry checks, compilation and the pack/unpack of frames. Shared by the PDO
+ * service and meant for the MPDO (which maps one object per frame: it can check an object
+ * with co_pdo_map_check() and move its bytes with co_pdo_ent_read()/co_pdo_ent_write()).
+ */
+
+#ifndef SAFELINE_SUBSYS_CANOPEN_PDO_PDO_INTERNAL_H_
+#define SAFELINE_SUBSYS_CANOPEN_PDO_PDO_INTERNAL_H_
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <canopen/od.h>
+#include <canopen/pdo.h>
+
+/* Largest data field of a classic CAN frame, in bits. */
+#define CO_PDO_MAX_BITS 64U
+
+/* Fields of a mapping entry (CiA 301 §7.5.2.36): index 31..16, sub 15..8, length 7..0. */
+#define CO_PDO_ENT_INDEX(e) ((uint16_t)((e) >> 16))
+#define CO_PDO_ENT_SUB(e)   ((uint8_t)((e) >> 8))
+#define CO_PDO_ENT_BITS(e)  ((uint8_t)(e))
+
+/*
+ * Resolve and check one mapping entry for a PDO of the given direction.
+ * rx: true for an RPDO (object written), false for a TPDO (object read).
+ * Returns 0 and fills *ent, or the abort code: 06020000h no such object, 06090011h no such
+ * sub-index, 06040041h not mappable in that direction / bad length / dummy in a TPDO.
+ */
+uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
+			  struct co_pdo_map_ent *ent);
+
+/* Whether an entry is a dummy (skips bits of an RPDO). */
+static inline bool co_pdo_ent_is_dummy(const struct co_pdo_map_ent *ent)
+{
+	return ent->info.desc == NULL && ent->info.prov == NULL;
+}
+
+/*
+ * The entry functions below keep ent->cover (which OD hooks cover the object) up to date,
+ * hence the non-const entries.
+ *
+ * Read the mapped bits of an object as little-endian bytes into out[8] (zeroed above them).
+ * Returns 0 or the reader's abort code (the bytes are then zero).
+ */
+uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uint8_t out[8],
+			 enum co_od_writer reader);
+
+/* Write the mapped bits (little-endian in val[8]) to the object; returns the abort code. */
+uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const uint8_t val[8],
+			  enum co_od_writer writer);
+
+/* Copy n bits of src (from bit 0) into dst at bit offset off; and the reverse. */
+void co_pdo_bits_put(uint8_t *dst, unsigned int off, unsigned int n, const uint8_t *src);
+void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8_t *dst);
+
+/* Sample every mapped object into data[8]; returns the frame length in bytes. */
+uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8]);
+
+/* Write every mapped object from data (at least the mapped bytes long); dummies are skipped.
+ * Returns the number of objects whose write was refused.
+ */
+int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data);
+
+struct co_node;
+struct can_frame;
+
+/* What became of a received MPDO (co_mpdo_rx()). */
+enum co_mpdo_rx_result {
+	CO_MPDO_RX_WRITTEN, /* the object was written */
+	CO_MPDO_RX_IGNORED, /* not for us / not dispatched */
+	CO_MPDO_RX_REFUSED, /* the dictionary refused the write */
+	CO_MPDO_RX_MISSING, /* DAM: no such object (EMCY 8230h) */
+};
+
+/*
+ * Send an MPDO frame (8 bytes) on an MPDO TPDO, now or at the end of its inhibit time
+ * (pdo.c). Returns 0 or -EBUSY when a frame already waits for the inhibit time.
+ */
+int co_tpdo_mpdo_send(struct co_tpdo *t, const uint8_t data[8]);
+
+#if defined(CONFIG_CANOPEN_MPDO)
+/* Note the scanner/dispatcher objects of the dictionary and hook their writes (mpdo.c). */
+int co_mpdo_init(struct co_node *node);
+
+/* Process an MPDO of DLC 8 received by an RPDO whose mapping sub 0 is @p mode (mpdo.c). */
+enum co_mpdo_rx_result co_mpdo_rx(struct co_node *node, uint8_t mode, const uint8_t data[8]);
+#endif
+
+#endif /* SAFELINE_SUBSYS_CANOPEN_PDO_PDO_INTERNAL_H_ */

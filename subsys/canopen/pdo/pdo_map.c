@@ -1,0 +1,218 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * PDO mapping (CiA 301 §7.5.2.36/38): resolving and checking entries once, then moving bits
+ * between frames and objects without lookups. Bits are numbered from bit 0 of byte 0 (the
+ * CANopen little-endian order); an object's bits go to the frame least significant first.
+ */
+
+#include <string.h>
+
+#include <zephyr/kernel.h>
+
+#include "pdo_internal.h"
+
+/* Length in bits of the dummy types 0001h-0007h (CiA 301 §7.4.7.1). */
+static const uint8_t dummy_bits[8] = {0, 1, 8, 16, 32, 8, 16, 32};
+
+static bool readable(uint8_t access)
+{
+	return access != CO_OD_ACCESS_WO;
+}
+
+static bool writable(uint8_t access)
+{
+	return access == CO_OD_ACCESS_WO || access == CO_OD_ACCESS_RW ||
+	       access == CO_OD_ACCESS_RWR || access == CO_OD_ACCESS_RWW;
+}
+
+static bool mappable(const struct co_od_info *info, bool rx)
+{
+	if ((info->flags & CO_OD_F_MAP) == 0U) {
+		return false;
+	}
+	if (rx) {
+		return writable(info->access) && info->access != CO_OD_ACCESS_RWR &&
+		       (info->flags & CO_OD_F_ROM) == 0U;
+	}
+	return readable(info->access) && info->access != CO_OD_ACCESS_RWW;
+}
+
+uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
+			  struct co_pdo_map_ent *ent)
+{
+	uint16_t index = CO_PDO_ENT_INDEX(entry);
+	uint8_t sub = CO_PDO_ENT_SUB(entry);
+	uint8_t bits = CO_PDO_ENT_BITS(entry);
+	bool bitwise = IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING);
+
+	memset(ent, 0, sizeof(*ent));
+	ent->bits = bits;
+	if (index >= 1U && index <= 7U) {
+		/* Dummy entries only skip bits of received frames. */
+		if (!rx || sub != 0U || bits != dummy_bits[index] ||
+		    (!bitwise && bits % 8U != 0U)) {
+			return CO_SDO_AB_NO_MAP;
+		}
+		ent->info.index = index;
+		ent->info.dtype = (uint8_t)index;
+		return 0U;
+	}
+	uint32_t ab = co_od_find(od, index, sub, &ent->info);
+
+	if (ab != 0U) {
+		return ab;
+	}
+	if (!mappable(&ent->info, rx) || bits == 0U) {
+		return CO_SDO_AB_NO_MAP;
+	}
+	if (bits > CO_PDO_MAX_BITS) {
+		return CO_SDO_AB_MAP_LEN;
+	}
+	uint32_t size_bits = ent->info.size * 8U;
+
+	if (bits > size_bits || (!bitwise && bits % 8U != 0U)) {
+		return CO_SDO_AB_NO_MAP;
+	}
+	/* Part of an object: only the low-order bits of a fixed-size number (bit-wise mode). */
+	if (bits < size_bits && (!bitwise || co_dtype_size(ent->info.dtype) == 0U)) {
+		return CO_SDO_AB_NO_MAP;
+	}
+	ent->whole = bits == size_bits;
+	return 0U;
+}
+
+void co_pdo_bits_put(uint8_t *dst, unsigned int off, unsigned int n, const uint8_t *src)
+{
+	for (unsigned int i = 0; i < n; i++) {
+		unsigned int d = off + i;
+		uint8_t m = (uint8_t)(1U << (d % 8U));
+
+		if ((src[i / 8U] >> (i % 8U)) & 1U) {
+			dst[d / 8U] |= m;
+		} else {
+			dst[d / 8U] &= (uint8_t)~m;
+		}
+	}
+}
+
+void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8_t *dst)
+{
+	for (unsigned int i = 0; i < n; i++) {
+		unsigned int s = off + i;
+		uint8_t m = (uint8_t)(1U << (i % 8U));
+
+		if ((src[s / 8U] >> (s % 8U)) & 1U) {
+			dst[i / 8U] |= m;
+		} else {
+			dst[i / 8U] &= (uint8_t)~m;
+		}
+	}
+}
+
+uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uint8_t out[8],
+			 enum co_od_writer reader)
+{
+	size_t len = 0;
+	size_t cap = ent->info.size < 8U ? ent->info.size : 8U;
+	unsigned int whole = ent->bits / 8U;
+	uint32_t ab;
+
+	memset(out, 0, 8);
+	ab = co_od_read_cached(od, &ent->info, &ent->cover, out, cap, &len, reader);
+	if (ab != 0U) {
+		memset(out, 0, 8);
+		return ab;
+	}
+	/* Keep only the mapped bits (bit-wise mapping of part of a number). */
+	if (ent->bits % 8U != 0U) {
+		out[whole] &= (uint8_t)((1U << (ent->bits % 8U)) - 1U);
+		whole++;
+	}
+	if (whole < 8U) {
+		memset(&out[whole], 0, 8U - whole);
+	}
+	return 0U;
+}
+
+uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const uint8_t val[8],
+			  enum co_od_writer writer)
+{
+	uint8_t buf[8];
+	uint32_t size = ent->info.size;
+
+	memcpy(buf, val, sizeof(buf));
+	/* A signed number mapped in part keeps its sign. */
+	if (ent->bits < size * 8U && co_dtype_class(ent->info.dtype) == CO_DTYPE_CLASS_INT &&
+	    ((buf[(ent->bits - 1U) / 8U] >> ((ent->bits - 1U) % 8U)) & 1U)) {
+		for (unsigned int b = ent->bits; b < size * 8U; b++) {
+			buf[b / 8U] |= (uint8_t)(1U << (b % 8U));
+		}
+	}
+	return co_od_write_cached(od, &ent->info, &ent->cover, buf, size, writer);
+}
+
+uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8])
+{
+	unsigned int off = 0;
+	uint8_t val[8];
+
+	memset(data, 0, 8);
+	for (uint8_t i = 0; i < map->n; i++) {
+		struct co_pdo_map_ent *ent = &map->ent[i];
+
+		if (map->bytewise && ent->whole) {
+			/* Straight into the frame: the mapping check made the sizes fit. */
+			size_t len = 0;
+
+			if (co_od_read_cached(od, &ent->info, &ent->cover, &data[off / 8U],
+					      ent->bits / 8U, &len, CO_OD_WRITER_PDO) != 0U) {
+				memset(&data[off / 8U], 0, ent->bits / 8U);
+			}
+			off += ent->bits;
+			continue;
+		}
+		(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
+		if (map->bytewise) {
+			memcpy(&data[off / 8U], val, ent->bits / 8U);
+		} else {
+			co_pdo_bits_put(data, off, ent->bits, val);
+		}
+		off += ent->bits;
+	}
+	return (uint8_t)((map->bits + 7U) / 8U);
+}
+
+int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data)
+{
+	unsigned int off = 0;
+	int refused = 0;
+	uint8_t val[8];
+
+	for (uint8_t i = 0; i < map->n; i++) {
+		struct co_pdo_map_ent *ent = &map->ent[i];
+
+		if (map->bytewise && ent->whole) {
+			/* A whole object in whole bytes: its wire value is in the frame. */
+			if (co_od_write_cached(od, &ent->info, &ent->cover, &data[off / 8U],
+					       ent->bits / 8U, CO_OD_WRITER_PDO) != 0U) {
+				refused++;
+			}
+		} else if (!co_pdo_ent_is_dummy(ent)) {
+			memset(val, 0, sizeof(val));
+			if (map->bytewise) {
+				memcpy(val, &data[off / 8U], ent->bits / 8U);
+			} else {
+				co_pdo_bits_get(data, off, ent->bits, val);
+			}
+			if (co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO) != 0U) {
+				refused++;
+			}
+		}
+		off += ent->bits;
+	}
+	return refused;
+}
