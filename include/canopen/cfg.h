@@ -19,7 +19,9 @@
  *    aborted with 08000024h.
  *  - 1F25h (configuration request): writing "conf" (666E6F63h) to sub n downloads the concise
  *    DCF of node n over the highest-numbered idle SDO client, rebound to node n's default
- *    SDO; sub 80h configures every node with a stored concise DCF, one after the other.
+ *    SDO (with the NMT master only clients above CONFIG_CANOPEN_MGR_SLAVES, which its slave
+ *    slots never use: 1F25h needs CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES + 1);
+ *    sub 80h configures every node with a stored concise DCF, one after the other.
  *    The write succeeds at once; the result is reported through the indication
  *    (co_cfg_set_ind()). Refusals: another value 06090030h, no data for n 08000024h,
  *    malformed data 08000020h, busy or node down 08000022h, no idle client 060A0023h.
@@ -293,7 +295,8 @@ int co_cfg_cdcf_check(const uint8_t *data, size_t len, uint32_t *entries);
  * @retval -ENOENT No concise DCF stored for @p id.
  * @retval -EBADMSG The stored concise DCF is malformed; nothing was sent.
  * @retval -EBUSY A download of @p id is running, all CONFIG_CANOPEN_CFG_JOBS downloads are
- *         running, or @p cli is busy.
+ *         running, or @p cli is busy: retry later (the NMT master's boot-up waits for a job
+ *         to end; it never fails a boot for this).
  * @retval -ENOTCONN, -ENETDOWN From co_sdo_cli_download_req() for the first entry.
  */
 int co_cfg_download_req(struct co_cfg *cfg, struct co_sdo_cli *cli, uint8_t id, co_cfg_con_t con,

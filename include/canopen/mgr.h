@@ -15,7 +15,10 @@
  * error handler and the boot-up handler, request NMT 1F82h and request guarding 1F83h.
  *
  * All slaves boot in parallel: slave slot i uses SDO client i of the node
- * (CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES).
+ * (CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES); clients above the slots are
+ * left to the application and to 1F25h requests of the configuration manager. Slaves that
+ * reach the configuration download while all CONFIG_CANOPEN_CFG_JOBS are running wait for a
+ * job (no boot fails for lack of one).
  *
  * Indications run in the node's line thread with the node's mutex held; they must not block.
  *
@@ -126,9 +129,13 @@ struct co_mgr_boot_info {
 	bool mandatory;
 	/** A boot process is running. */
 	bool booting;
-	/** enum co_mgr_status of the last finished boot (CO_MGR_ST_NONE: none yet). */
+	/**
+	 * enum co_mgr_status of the last finished boot attempt (CO_MGR_ST_NONE: none yet). An
+	 * attempt in progress (booting) does not change it, nor device_type, identity,
+	 * read_mask and error: they all describe that last finished attempt.
+	 */
 	uint8_t status;
-	/** Identity read: 1000h, 1018h:01..04, and which of them were read (bit i). */
+	/** Identity read by the last finished attempt: 1000h, 1018h:01..04, which (bit i). */
 	uint32_t device_type;
 	uint32_t identity[4];
 	uint8_t read_mask;
@@ -137,7 +144,10 @@ struct co_mgr_boot_info {
 	/** Start of the boot process and end of the last attempt [µs, line time]. */
 	uint64_t started_us;
 	uint64_t finished_us;
-	/** The master's view of the slave's NMT state (1F82h read value: 0, 1, 4, 5, 7Fh). */
+	/**
+	 * The master's view of the slave's NMT state (1F82h read value: 0, 1, 4, 5, 7Fh): the
+	 * state it commanded last, or reported last, whichever came later.
+	 */
 	uint8_t nmt_state;
 	/** Last error (valid when status is an error letter). */
 	struct co_mgr_boot_error error;
@@ -151,7 +161,12 @@ enum co_mgr_ec_event {
 	CO_MGR_EC_HB_LOST,
 	/** No node guarding reply within guard time x retry factor. */
 	CO_MGR_EC_GUARD_LOST,
-	/** The slave's reported NMT state changed. */
+	/**
+	 * The slave's reported NMT state changed: a heartbeat or node-guarding reply carries
+	 * another state than the last one the slave reported (the first report after the start
+	 * of supervision or a loss counts; a boot-up reports Pre-operational). States the master
+	 * commanded raise it too, when the slave confirms them.
+	 */
 	CO_MGR_EC_STATE,
 };
 
@@ -209,6 +224,12 @@ struct co_mgr_slave {
 	uint32_t sw_date;
 	uint32_t cfg_date;
 	struct co_mgr_boot_error err;
+	/* Result of the last finished attempt (co_mgr_get_boot()); the fields above are the
+	 * attempt in progress.
+	 */
+	struct co_mgr_boot_error last_err;
+	uint32_t last_ident[5];
+	uint32_t cfg_ticket; /* order of the wait for a configuration job */
 	uint16_t attempts;
 	uint16_t guard_ms;
 	uint16_t hb_ms;
@@ -218,6 +239,9 @@ struct co_mgr_slave {
 	uint8_t status;
 	uint8_t nmt_state; /* 1F82h read value */
 	uint8_t read_mask;
+	uint8_t last_status;
+	uint8_t last_read_mask;
+	uint8_t rep_state; /* last state the slave reported (heartbeat, guarding), 0: none */
 	uint8_t guard_rf;
 	uint8_t guard_missed;
 	uint8_t guard_toggle; /* toggle bit expected in the next reply, 0xff: not yet known */
@@ -234,6 +258,7 @@ struct co_mgr_slave {
 	bool ec_lost;
 	bool wait_reboot;    /* after an error-handler reset, waiting for the boot-up */
 	bool start_deferred; /* booted while a mandatory slave was still booting */
+	bool cfg_wait;       /* DOWNLOAD step waiting for a configuration job slot */
 };
 
 struct co_mgr_nmt_cmd {
@@ -252,12 +277,13 @@ struct co_mgr {
 	uint64_t nmt_next_us;
 	uint16_t nmt_head;
 	uint16_t nmt_count;
-	uint8_t startup;    /* enum co_mgr_startup */
-	uint8_t phase;      /* internal startup phase */
-	uint8_t exclude_id; /* 1F82h 84h..8Fh requester */
-	bool boot_pending;  /* Reset communication seen; startup on Pre-operational */
-	bool od_update;     /* the manager writes 1F82h/1F83h itself */
-	bool nmt_self_busy; /* applying a command to ourselves */
+	uint8_t startup;      /* enum co_mgr_startup */
+	uint8_t phase;        /* internal startup phase */
+	uint8_t exclude_id;   /* 1F82h 84h..8Fh requester */
+	bool boot_pending;    /* Reset communication seen; startup on Pre-operational */
+	bool od_update;       /* the manager writes 1F82h/1F83h itself */
+	bool nmt_self_busy;   /* applying a command to ourselves */
+	uint32_t cfg_tickets; /* waits for a configuration job, in order */
 	struct co_mgr_boot_error halt_err;
 	struct co_mgr_slave slaves[CONFIG_CANOPEN_MGR_SLAVES];
 	co_mgr_boot_ind_t boot_ind;

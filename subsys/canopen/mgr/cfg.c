@@ -583,10 +583,21 @@ static void indicate(struct co_cfg *cfg, uint8_t id, uint32_t ab, uint16_t index
 	}
 }
 
-/* The idle client with the highest number: the NMT master boots slave slot i on client i. */
+/*
+ * Clients a 1F25h request may use: the NMT master boots slave slot i on client i and aborts
+ * whatever that client does when the slot's slave (re)boots, so the slot clients are never
+ * lent to 1F25h (doc/cfg.md: CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES + 1).
+ */
+#if defined(CONFIG_CANOPEN_MGR)
+#define REQ_CLI_FIRST CONFIG_CANOPEN_MGR_SLAVES
+#else
+#define REQ_CLI_FIRST 0
+#endif
+
+/* The idle client with the highest number among those 1F25h may use. */
 static struct co_sdo_cli *idle_client(struct co_cfg *cfg)
 {
-	for (int i = CONFIG_CANOPEN_SDO_CLIENTS - 1; i >= 0; i--) {
+	for (int i = CONFIG_CANOPEN_SDO_CLIENTS - 1; i >= REQ_CLI_FIRST; i--) {
 		struct co_sdo_cli *cli = co_sdo_cli_get(cfg->node, (uint8_t)i);
 		bool used = false;
 

@@ -94,6 +94,12 @@ enum {
 
 #define MS_US(ms) ((uint64_t)(ms) * 1000U)
 
+/*
+ * A slave waiting for a configuration job is started when a download of the manager ends;
+ * this poll only covers jobs of others (1F25h) ending.
+ */
+#define CFG_WAIT_POLL_MS 100U
+
 /* "load" (CiA 301 1011h) on the wire. */
 static const uint8_t sig_load[4] = {'l', 'o', 'a', 'd'};
 
@@ -173,7 +179,12 @@ static struct co_mgr_slave *slot_get(struct co_mgr *m, uint8_t id)
 		if (s->id == 0U) {
 			s->id = id;
 			s->status = CO_MGR_ST_NONE;
+			s->last_status = CO_MGR_ST_NONE;
+			s->last_read_mask = 0U;
+			memset(s->last_ident, 0, sizeof(s->last_ident));
+			memset(&s->last_err, 0, sizeof(s->last_err));
 			s->nmt_state = 0U;
+			s->rep_state = 0U;
 			return s;
 		}
 	}
@@ -386,6 +397,8 @@ static void ec_event(struct co_mgr_slave *s, enum co_mgr_ec_event ev)
 		return;
 	}
 	s->ec_lost = true;
+	/* The next report after the loss is a change, whatever it says. */
+	s->rep_state = 0U;
 	LOG_WRN("%s: node %u %s", m->node->name, s->id,
 		ev == CO_MGR_EC_HB_LOST ? "heartbeat lost" : "node guarding lost");
 	set_nmt_view(s, 0x01U);
@@ -452,6 +465,7 @@ static uint8_t fail(struct co_mgr_slave *s, uint8_t status, uint16_t index, uint
 }
 
 static void sdo_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, void *user_data);
+static void boot_run(struct co_mgr_slave *s, uint8_t next);
 
 static uint32_t buf_u32(struct co_mgr_slave *s)
 {
@@ -800,6 +814,8 @@ static uint8_t st_restore_reset_to(struct co_mgr_slave *s)
 
 /* Concise DCF through the configuration manager; nothing stored = nothing to do. */
 #if defined(CONFIG_CANOPEN_CFG)
+static void cfg_kick(struct co_mgr *m);
+
 static void cfg_con(struct co_node *node, uint8_t id, uint32_t abort_code, uint16_t index,
 		    uint8_t sub, void *user_data)
 {
@@ -808,6 +824,8 @@ static void cfg_con(struct co_node *node, uint8_t id, uint32_t abort_code, uint1
 	s->err.index = index;
 	s->err.sub = sub;
 	sdo_con(cli_of(s), abort_code, 0, s);
+	/* A job slot is free now: hand it to the slave that waits longest. */
+	cfg_kick(s->mgr);
 }
 #endif
 
@@ -820,11 +838,26 @@ static uint8_t st_download(struct co_mgr_slave *s)
 	if (cfg == NULL) {
 		return CO_MGR_STEP_START_EC;
 	}
+	if (!s->cfg_wait) {
+		s->cfg_ticket = s->mgr->cfg_tickets++;
+	}
+	s->cfg_wait = false;
 	s->sdo_pending = true;
 	err = co_cfg_download_req(cfg, cli_of(s), s->id, cfg_con, s);
 	if (err == -ENOENT) {
 		s->sdo_pending = false;
 		return CO_MGR_STEP_START_EC;
+	}
+	if (err == -EBUSY) {
+		/*
+		 * Every job slot is in use (or 1F25h configures this node): a matter of time,
+		 * never a failure. The end of one of our downloads starts the next waiting
+		 * slave (cfg_kick()); the timer retries for jobs that are not ours.
+		 */
+		s->sdo_pending = false;
+		s->cfg_wait = true;
+		arm(s, CFG_WAIT_POLL_MS);
+		return NEXT_WAIT;
 	}
 	if (err != 0) {
 		s->sdo_pending = false;
@@ -835,6 +868,40 @@ static uint8_t st_download(struct co_mgr_slave *s)
 	return CO_MGR_STEP_START_EC;
 #endif
 }
+
+#if defined(CONFIG_CANOPEN_CFG)
+/*
+ * Start the waiting downloads, oldest wait first, while job slots are free. A slave whose own
+ * node a 1F25h request configures right now is left to its poll.
+ */
+static void cfg_kick(struct co_mgr *m)
+{
+	struct co_cfg *cfg = co_cfg_get(m->node);
+
+	for (;;) {
+		struct co_mgr_slave *w = NULL;
+
+		for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+			struct co_mgr_slave *o = &m->slaves[i];
+
+			if (o->id != 0U && o->booting && o->cfg_wait &&
+			    o->step == CO_MGR_STEP_DOWNLOAD && !co_cfg_busy(cfg, o->id) &&
+			    (w == NULL || (int32_t)(o->cfg_ticket - w->cfg_ticket) < 0)) {
+				w = o;
+			}
+		}
+		if (w == NULL) {
+			return;
+		}
+		co_timer_stop(&w->timer);
+		boot_run(w, st_download(w));
+		if (w->cfg_wait) {
+			/* Still no slot (re-armed): the others wait too. */
+			return;
+		}
+	}
+}
+#endif
 
 static uint8_t st_download_sdo(struct co_mgr_slave *s, uint32_t ab)
 {
@@ -940,7 +1007,7 @@ static const struct boot_state boot_table[CO_MGR_STEP_COUNT] = {
 	[CO_MGR_STEP_RESTORE] = {"RESTORE", st_restore, st_restore_sdo, NULL, NULL},
 	[CO_MGR_STEP_RESTORE_RESET] = {"RESTORE_RESET", st_wait_bootup, NULL, st_restore_reset_ec,
 				       st_restore_reset_to},
-	[CO_MGR_STEP_DOWNLOAD] = {"DOWNLOAD", st_download, st_download_sdo, NULL, NULL},
+	[CO_MGR_STEP_DOWNLOAD] = {"DOWNLOAD", st_download, st_download_sdo, NULL, st_download},
 	[CO_MGR_STEP_START_EC] = {"START_EC", st_start_ec, NULL, st_start_ec_ec, st_start_ec_to},
 	[CO_MGR_STEP_START] = {"START", st_start, NULL, NULL, NULL},
 };
@@ -953,6 +1020,15 @@ const char *co_mgr_step_str(enum co_mgr_step step)
 /* --- Boot process (302-2 §3.3) and NMT startup (302-2 §3.1) -------------------------------- */
 
 static void boot_end(struct co_mgr_slave *s);
+
+/* The attempt finished: its result becomes the one co_mgr_get_boot() reports. */
+static void publish(struct co_mgr_slave *s)
+{
+	s->last_status = s->status;
+	s->last_read_mask = s->read_mask;
+	memcpy(s->last_ident, s->ident, sizeof(s->last_ident));
+	s->last_err = s->err;
+}
 
 static void boot_run(struct co_mgr_slave *s, uint8_t next)
 {
@@ -990,7 +1066,10 @@ static void boot_attempt(struct co_mgr_slave *s)
 	s->read_mask = 0U;
 	s->wait_reboot = false;
 	s->start_deferred = false;
+	s->cfg_wait = false;
+	/* The working record; co_mgr_get_boot() shows the last finished one until boot_end(). */
 	memset(&s->err, 0, sizeof(s->err));
+	memset(s->ident, 0, sizeof(s->ident));
 	ec_stop(s);
 	if (co_sdo_cli_busy(cli_of(s))) {
 		s->sdo_pending = false;
@@ -1042,6 +1121,8 @@ static void boot_end(struct co_mgr_slave *s)
 	s->tried = true;
 	s->finished_us = now;
 	s->step = CO_MGR_STEP_IDLE;
+	s->cfg_wait = false;
+	publish(s);
 	if (s->status == CO_MGR_ST_OK) {
 		LOG_INF("%s: node %u booted", m->node->name, s->id);
 	} else {
@@ -1166,7 +1247,10 @@ static void boot_timer_handler(struct co_timer *timer, uint64_t now_us)
 				(void)fail(s, CO_MGR_ST_B, IDX_BOOT_TIME, 0,
 					   od_u32(m, IDX_BOOT_TIME, 0), 0U, 0U);
 				s->booting = false;
+				s->cfg_wait = false;
 				s->step = CO_MGR_STEP_IDLE;
+				s->finished_us = now_us;
+				publish(s);
 			}
 		}
 		halt(m, &s->err);
@@ -1303,6 +1387,10 @@ static void bootup_handler(struct co_mgr *m, uint8_t id, struct co_mgr_slave *s)
 		return;
 	}
 	ec_indicate(m, id, CO_MGR_EC_BOOTUP, 0U);
+	if (s != NULL) {
+		/* The boot-up reports Pre-operational (its own event, not a state change). */
+		s->rep_state = CO_NMT_PRE_OPERATIONAL;
+	}
 	if (s == NULL || (assign_of(m, id) & AS_SLAVE) == 0U) {
 		/* Not in 1F81h: the application's business (302-2 §3.1). */
 		return;
@@ -1374,6 +1462,13 @@ static void ec_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	}
 	if (state != s->nmt_state) {
 		set_nmt_view(s, state);
+	}
+	/*
+	 * The event follows what the slave reports, not the master's view: a start the master
+	 * sent set the view already, its confirmation by the heartbeat is still a change.
+	 */
+	if (state != s->rep_state) {
+		s->rep_state = state;
 		ec_indicate(m, id, CO_MGR_EC_STATE, state);
 	}
 	if (s->booting && boot_table[s->step].ec != NULL) {
@@ -1604,7 +1699,10 @@ static void slaves_reset(struct co_mgr *m)
 		s->wait_reboot = false;
 		s->start_deferred = false;
 		s->tried = false;
+		s->cfg_wait = false;
 		s->status = CO_MGR_ST_NONE;
+		s->last_status = CO_MGR_ST_NONE;
+		s->rep_state = 0U;
 		s->step = CO_MGR_STEP_IDLE;
 		s->attempts = 0U;
 	}
@@ -1631,6 +1729,7 @@ int co_mgr_init(struct co_node *node)
 		s->mgr = m;
 		s->slot = (uint8_t)i;
 		s->status = CO_MGR_ST_NONE;
+		s->last_status = CO_MGR_ST_NONE;
 		co_timer_init(&s->timer, slave_timer_handler, &node->lock, s);
 		co_timer_init(&s->ec_timer, ec_timer_handler, &node->lock, s);
 	}
@@ -1776,15 +1875,16 @@ int co_mgr_get_boot(struct co_node *node, uint8_t id, struct co_mgr_boot_info *i
 			.assigned = (as & AS_SLAVE) != 0U,
 			.mandatory = (as & AS_MANDATORY) != 0U,
 			.booting = s->booting,
-			.status = s->status,
-			.device_type = s->ident[0],
-			.identity = {s->ident[1], s->ident[2], s->ident[3], s->ident[4]},
-			.read_mask = s->read_mask,
+			.status = s->last_status,
+			.device_type = s->last_ident[0],
+			.identity = {s->last_ident[1], s->last_ident[2], s->last_ident[3],
+				     s->last_ident[4]},
+			.read_mask = s->last_read_mask,
 			.attempts = s->attempts,
 			.started_us = s->started_us,
 			.finished_us = s->finished_us,
 			.nmt_state = s->nmt_state,
-			.error = s->err,
+			.error = s->last_err,
 		};
 	}
 	co_node_unlock(node);

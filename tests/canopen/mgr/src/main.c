@@ -108,6 +108,7 @@ static struct {
 	int n_ec_ind;
 	uint8_t ec_id[64];
 	enum co_mgr_ec_event ec_ev[64];
+	enum co_nmt_state ec_state[64];
 	int sw_calls;
 	int sw_result;
 	int op_at_log;
@@ -480,6 +481,7 @@ static void ec_ind(struct co_node *node, uint8_t id, enum co_mgr_ec_event ev,
 	if (t.n_ec_ind < 64) {
 		t.ec_id[t.n_ec_ind] = id;
 		t.ec_ev[t.n_ec_ind] = ev;
+		t.ec_state[t.n_ec_ind] = state;
 		t.n_ec_ind++;
 	}
 }
@@ -2016,3 +2018,226 @@ ZTEST(co_mgr, test_more_slaves_than_slots_mandatory_without_slot_halts)
 	zassert_equal(t.startup_err.index, 0x1F81);
 	zassert_equal(count_nmt_cs(0x01), 0);
 }
+
+/* --- Regressions: retry view, reported states, job slots, 1F25h clients ----------------------- */
+
+ZTEST(co_mgr, test_boot_table_keeps_last_result_during_a_retry)
+{
+	struct co_mgr_boot_info bi;
+	bool seen_retry = false;
+
+	baseline();
+	fake_std(2);
+	fake_std(3)->present = false;
+	fake_std(4);
+	start_master();
+	run_for(500 * MS);
+	zassert_ok(co_mgr_get_boot(&t.master, 3, &bi));
+	zassert_false(bi.booting);
+	zassert_equal(bi.status, CO_MGR_ST_B);
+	zassert_equal(bi.attempts, 1);
+	/* The second attempt: 1 s retry period, 100 ms SDO timeout. */
+	for (int i = 0; i < 150 && !seen_retry; i++) {
+		run_for(10 * MS);
+		zassert_ok(co_mgr_get_boot(&t.master, 3, &bi));
+		seen_retry = bi.booting && bi.attempts == 2;
+	}
+	zassert_true(seen_retry, "no retry seen");
+	/* Mid-retry: the table still shows the last finished boot (mgr.h). */
+	zassert_equal(bi.status, CO_MGR_ST_B, "mid-retry status %02x", bi.status);
+	zassert_equal(bi.error.status, CO_MGR_ST_B);
+	zassert_equal(bi.error.node_id, 3);
+	zassert_equal(bi.error.abort_code, CO_SDO_AB_TIMEOUT);
+	zassert_equal(bi.error.index, 0x1000);
+	/* It answers now: the attempt in progress ends OK and replaces the old result. */
+	t.fakes[1].present = true;
+	run_for(1200 * MS);
+	zassert_ok(co_mgr_get_boot(&t.master, 3, &bi));
+	zassert_false(bi.booting);
+	zassert_equal(bi.status, CO_MGR_ST_OK);
+	zassert_equal(bi.read_mask & BIT(0), BIT(0));
+	zassert_equal(bi.device_type, 0x00020192);
+}
+
+ZTEST(co_mgr, test_boot_table_keeps_identity_of_last_boot_while_rebooting)
+{
+	struct co_mgr_boot_info bi;
+
+	baseline();
+	fake_std(2);
+	start_master();
+	run_for(500 * MS);
+	zassert_ok(co_mgr_get_boot(&t.master, 2, &bi));
+	zassert_equal(bi.status, CO_MGR_ST_OK);
+	/* The slave goes silent and reboots (boot-up, then no SDO answer). */
+	t.fakes[0].present = false;
+	fake_ec(&t.fakes[0], 0x00);
+	run_for(50 * MS);
+	zassert_ok(co_mgr_get_boot(&t.master, 2, &bi));
+	zassert_true(bi.booting);
+	zassert_equal(bi.status, CO_MGR_ST_OK, "mid-boot status %02x", bi.status);
+	zassert_equal(bi.read_mask & BIT(0), BIT(0), "identity of the last boot kept");
+	zassert_equal(bi.device_type, 0x00020192);
+	run_for(100 * MS);
+	zassert_ok(co_mgr_get_boot(&t.master, 2, &bi));
+	zassert_equal(bi.status, CO_MGR_ST_B);
+	zassert_equal(bi.read_mask, 0);
+}
+
+static int count_ec_state(uint8_t id, enum co_nmt_state st)
+{
+	int n = 0;
+
+	for (int i = 0; i < t.n_ec_ind; i++) {
+		n += t.ec_id[i] == id && t.ec_ev[i] == CO_MGR_EC_STATE && t.ec_state[i] == st ? 1
+											      : 0;
+	}
+	return n;
+}
+
+ZTEST(co_mgr, test_state_event_fires_for_reported_states_the_master_commanded)
+{
+	baseline();
+	cfg(0x1016, 1, (2U << 16) | 300U, 4);
+	struct fake *f = fake_std(2);
+
+	f->hb_ms = 100;
+	f->next_hb = 20 * MS;
+	start_master();
+	run_for(1000 * MS);
+	zassert_equal(last_boot_status(2), CO_MGR_ST_OK);
+	zassert_equal(f->state, 0x05, "started");
+	/* The boot-up reported Pre-operational; the heartbeats then confirmed Operational. */
+	zassert_equal(count_ec(2, CO_MGR_EC_BOOTUP), 1);
+	zassert_equal(count_ec_state(2, CO_NMT_PRE_OPERATIONAL), 0);
+	zassert_equal(count_ec_state(2, CO_NMT_OPERATIONAL), 1, "confirmation of the start");
+	zassert_equal(count_ec(2, CO_MGR_EC_STATE), 1);
+	/* A commanded stop: the event comes with the heartbeat that reports it. */
+	zassert_equal(od_write_u(&t.master, 0x1F82, 2, 0x04, 1, CO_OD_WRITER_SDO), 0U);
+	run_for(1 * MS);
+	zassert_equal(count_ec_state(2, CO_NMT_STOPPED), 0, "not reported yet");
+	run_for(200 * MS);
+	zassert_equal(count_ec_state(2, CO_NMT_STOPPED), 1);
+	zassert_equal(count_ec(2, CO_MGR_EC_STATE), 2);
+	zassert_equal(od_read_u(&t.master, 0x1F82, 2), 0x04);
+	/* Unchanged heartbeats raise nothing. */
+	run_for(500 * MS);
+	zassert_equal(count_ec(2, CO_MGR_EC_STATE), 2);
+}
+
+#if defined(CONFIG_CANOPEN_CFG)
+ZTEST(co_mgr, test_more_slaves_than_cfg_jobs_wait_for_a_job_never_J)
+{
+	/* More slaves with a concise DCF than download jobs: the rest must wait, not fail. */
+	const uint8_t n = (uint8_t)MIN(CO_CFG_JOBS + 2, CONFIG_CANOPEN_MGR_SLAVES);
+	int first[16];
+	int last[16];
+
+	zassert_true(n > CO_CFG_JOBS, "needs more slots than jobs");
+	cfg(0x1F80, 0, 0x01, 4);
+	for (uint8_t i = 0; i < n; i++) {
+		struct fake *f;
+
+		cfg(0x1F81, 2 + i, 0x05, 4);
+		f = fake_std(2 + i);
+		fake_obj(f, 0x1017, 0, 0, 0);
+		fake_obj(f, 0x2000, 0, 0, 0);
+		zassert_ok(co_cfg_set_concise_dcf(&t.cfgm, 2 + i, cdcf_ok, sizeof(cdcf_ok)));
+	}
+	start_master();
+	run_for(1000 * MS);
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_DONE);
+	for (uint8_t i = 0; i < n; i++) {
+		struct co_mgr_boot_info bi;
+		uint8_t id = 2 + i;
+
+		zassert_equal(last_boot_status(id), CO_MGR_ST_OK, "node %u: %c", id,
+			      last_boot_status(id));
+		zassert_ok(co_mgr_get_boot(&t.master, id, &bi));
+		zassert_equal(bi.attempts, 1, "node %u", id);
+		zassert_equal(fake_find(id)->n_down, 2, "node %u configured", id);
+		zassert_equal(count_nmt(0x01, id), 1, "node %u started", id);
+		first[i] = first_sdo(id, false, 0x1017, 0);
+		last[i] = first_sdo(id, false, 0x2000, 0);
+		zassert_true(first[i] >= 0 && last[i] > first[i]);
+	}
+	/* Never more than CO_CFG_JOBS downloads at once. */
+	for (int k = 0; k < t.n_log; k++) {
+		int running = 0;
+
+		for (uint8_t i = 0; i < n; i++) {
+			running += first[i] <= k && k <= last[i] ? 1 : 0;
+		}
+		zassert_true(running <= CO_CFG_JOBS, "%d downloads at frame %d", running, k);
+	}
+}
+
+static struct {
+	int n;
+	uint8_t id;
+	uint32_t ab;
+} req_ind;
+
+static void req_ind_cb(struct co_node *node, uint8_t id, uint32_t abort_code, uint16_t index,
+		       uint8_t sub, void *user_data)
+{
+	req_ind.n++;
+	req_ind.id = id;
+	req_ind.ab = abort_code;
+}
+
+/*
+ * 1F25h never borrows a slave slot's SDO client: that slot's boot would abort the transfer.
+ * With SDO_CLIENTS == MGR_SLAVES there is none to spare (refused); with one more it runs on
+ * the spare client even while the slave of the last slot reboots.
+ */
+ZTEST(co_mgr, test_1f25h_uses_only_clients_above_the_slave_slots)
+{
+	const uint8_t last_id = 1 + CONFIG_CANOPEN_MGR_SLAVES; /* slot MGR_SLAVES - 1 */
+	struct fake *f2;
+	uint32_t ab;
+
+	zassert_true(CONFIG_CANOPEN_MGR_SLAVES + 1 <= MAX_FAKES);
+	memset(&req_ind, 0, sizeof(req_ind));
+	cfg(0x1F80, 0, 0x01, 4);
+	for (uint8_t id = 2; id <= last_id; id++) {
+		cfg(0x1F81, id, 0x05, 4);
+		fake_std(id);
+	}
+	f2 = fake_find(2);
+	fake_obj(f2, 0x1017, 0, 0, 0);
+	fake_obj(f2, 0x2000, 0, 0, 0);
+	zassert_ok(co_cfg_set_concise_dcf(&t.cfgm, 2, cdcf_ok, sizeof(cdcf_ok)));
+	zassert_ok(co_cfg_set_ind(&t.cfgm, req_ind_cb, NULL));
+	start_master();
+	run_for(500 * MS);
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_DONE);
+	zassert_equal(last_boot_status(last_id), CO_MGR_ST_OK);
+	zassert_equal(f2->n_down, 2);
+	int n = t.n_log;
+
+	ARG_UNUSED(n);
+	ab = od_write_u(&t.master, 0x1F25, 2, CO_CFG_SIGNATURE_CONF, 4, CO_OD_WRITER_SDO);
+#if CONFIG_CANOPEN_SDO_CLIENTS > CONFIG_CANOPEN_MGR_SLAVES
+	zassert_equal(ab, 0U, "abort %08x", ab);
+#else
+	zassert_equal(ab, CO_SDO_AB_NO_RESOURCE, "no spare client, yet abort %08x", ab);
+#endif
+	/* The slave of the last slot reboots while the request runs. */
+	fake_ec(fake_find(last_id), 0x00);
+	run_for(500 * MS);
+	zassert_equal(count_sdo(last_id, true, 0x1000, 0), 2, "slave of the last slot rebooted");
+	zassert_equal(last_boot_status(last_id), CO_MGR_ST_OK);
+#if CONFIG_CANOPEN_SDO_CLIENTS > CONFIG_CANOPEN_MGR_SLAVES
+	zassert_equal(req_ind.n, 1);
+	zassert_equal(req_ind.id, 2);
+	zassert_equal(req_ind.ab, 0U, "1F25h download cut: %08x", req_ind.ab);
+	zassert_equal(f2->n_down, 4, "both entries again");
+#else
+	zassert_equal(req_ind.n, 0);
+	for (int i = n; i < t.n_log; i++) {
+		zassert_false(is_sdo(&t.log[i].f, 2, false, -1, -1), "no download to 2");
+	}
+#endif
+}
+#endif /* CONFIG_CANOPEN_CFG */
