@@ -379,3 +379,18 @@ def test_vm_dying_midway_is_an_error(tmp_path):
     assert run.returncode == 1
     s = run.suite("fake.vcan.ztest")
     assert s["status"] == "error" and "exit 125" in s["reason"] and "guest died" in s["reason"]
+
+
+def test_vm_batch_overlaps_the_host_instances(tmp_path):
+    # The vcan instances are built first and their VM batch starts at once, while the host
+    # instances still run: here the VM's two results come before the 2 s hang is killed, where
+    # a VM run after every host instance would report them last.
+    vm = make_vm(tmp_path, PASSTHROUGH_VM)
+    run = run_twister(["-T", FAKE / "vcan", "-T", FAKE / "hang", "-X", "vcan", "--vcan-vm", vm,
+                       "-j", "1"], tmp_path / "o", fake=True,
+                      env={"VM_ARGS_FILE": str(tmp_path / "vm-args.txt")})
+    progress = [line for line in run.lines if " native_posix " in line and "/3 " in line]
+    order = [next(n for n in ("fake.vcan.ztest", "fake.vcan.pytest", "fake.hang") if n in line)
+             for line in progress]
+    assert order.index("fake.hang") == 2, progress
+    assert run.suite("fake.hang")["reason"] == "timeout"

@@ -86,6 +86,8 @@ def pytest_command(spec: RunSpec) -> list[str]:
         "-p",
         "no:cacheprovider",  # nothing written into the source tree
         "-q",
+        # The slowest cases in the log: where an interop scenario's time goes.
+        "--durations=8",
         *spec.harness_config.get("pytest_args", []),
     ]
 

@@ -1,8 +1,10 @@
 """The pipeline: build, filter, run and judge every planned instance, -j at a time.
 
 Each worker takes one instance through configure -> runtime filter -> build -> run. Instances
-with `fixture: vcan` stop after the build; once every host instance is done they run together
-in one VM (vm.py). A progress line is printed as each instance finishes.
+with `fixture: vcan` are built first and stop after the build; as soon as the last of them is
+built they run together in one VM (vm.py), in a thread of their own, while the workers go on
+with the host instances (the VM's run is mostly waiting on the bus, so the two overlap
+well). A progress line is printed as each instance finishes.
 """
 
 import os
@@ -59,6 +61,9 @@ class Runner:
         self.done = 0
         self.total = 0
         self.vcan_queue: list[TestInstance] = []
+        # vcan instances still on their way through the build (the VM starts at 0).
+        self.vcan_pending = 0
+        self.vcan_thread: threading.Thread | None = None
         self.interrupted = False
 
     # --- progress -----------------------------------------------------------------------------
@@ -148,14 +153,33 @@ class Runner:
 
     def process(self, inst: TestInstance) -> None:
         """Take one instance through the pipeline (worker thread)."""
+        queued = False
         try:
-            if not self._process(inst):
-                return  # queued for the VM
+            queued = not self._process(inst)
         except Exception as e:  # a runner bug must not hang or hide the rest of the run
             inst.set_status(st.ERROR, f"runner error: {e!r}")
-        if handler.REGISTRY.interrupted.is_set() and inst.status not in (st.PASSED, st.FILTERED):
-            inst.set_status(st.SKIPPED, "interrupted")
-        self._finish(inst)
+        if not queued:
+            if handler.REGISTRY.interrupted.is_set() and inst.status not in (st.PASSED,
+                                                                             st.FILTERED):
+                inst.set_status(st.SKIPPED, "interrupted")
+            self._finish(inst)
+        if self._wants_vm(inst):
+            self._vcan_built()
+
+    def _wants_vm(self, inst: TestInstance) -> bool:
+        return inst.scenario.fixture == VCAN_FIXTURE and VCAN_FIXTURE in self.opts.fixtures
+
+    def _vcan_built(self) -> None:
+        """One more vcan instance is through its build (queued or done): start the VM batch
+        when it was the last."""
+        with self.lock:
+            self.vcan_pending -= 1
+            start = self.vcan_pending == 0 and bool(self.vcan_queue)
+            todo = sorted(self.vcan_queue, key=lambda i: i.name) if start else []
+        if start and not handler.REGISTRY.interrupted.is_set():
+            self.vcan_thread = threading.Thread(target=self._run_vcan, args=(todo,),
+                                                name="vcan-vm", daemon=True)
+            self.vcan_thread.start()
 
     def _process(self, inst: TestInstance) -> bool:
         interrupted = handler.REGISTRY.interrupted
@@ -229,10 +253,14 @@ class Runner:
         parallel = max(1, min(self.opts.jobs, len(todo)))
         if self.opts.build.ninja_jobs is None:
             self.opts.build.ninja_jobs = max(1, n_cpu // parallel)
+        # The VM's instances first, so their batch can start while the host ones build.
+        todo.sort(key=lambda i: not self._wants_vm(i))
+        self.vcan_pending = sum(1 for i in todo if self._wants_vm(i))
         try:
             self._run_pool(todo, self.process)
-            if self.vcan_queue and not handler.REGISTRY.interrupted.is_set():
-                self._run_vcan(sorted(self.vcan_queue, key=lambda i: i.name))
+            if self.vcan_thread is not None:
+                while self.vcan_thread.is_alive():
+                    self.vcan_thread.join(timeout=0.5)
             for attempt in range(1, self.opts.retry_failed + 1):
                 if handler.REGISTRY.interrupted.is_set():
                     break
