@@ -19,6 +19,7 @@
 
 #include "line_internal.h"
 
+#include "co_sim.h"
 #include "emcy_bare_od.h"
 #include "emcy_test_od.h"
 
@@ -28,13 +29,8 @@
 #define MAX_TX  64
 
 static struct {
-	struct co_line line;
 	struct co_node node;
 	struct emcy_test_od_ram ram;
-	struct can_frame sent[MAX_TX];
-	uint64_t sent_at[MAX_TX];
-	int n_sent;
-	uint64_t now;
 	/* Consumer indications seen. */
 	int n_ind;
 	uint16_t ind_cob[8];
@@ -43,14 +39,6 @@ static struct {
 	uint8_t ind_reg[8];
 	uint8_t ind_msef[8][5];
 } t;
-
-static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
-{
-	zassert_true(t.n_sent < MAX_TX, "too many frames");
-	t.sent_at[t.n_sent] = t.now;
-	t.sent[t.n_sent++] = *frame;
-	return 0;
-}
 
 static void emcy_ind(struct co_node *node, uint16_t cob_id, uint8_t remote_id, uint16_t code,
 		     uint8_t reg, const uint8_t msef[5], void *user_data)
@@ -62,53 +50,6 @@ static void emcy_ind(struct co_node *node, uint16_t cob_id, uint8_t remote_id, u
 	t.ind_reg[t.n_ind] = reg;
 	memcpy(t.ind_msef[t.n_ind], msef, 5);
 	t.n_ind++;
-}
-
-/* Advance simulated time to @p at, running every deadline on the way. */
-static void run_until(uint64_t at)
-{
-	while (true) {
-		uint64_t next = co_line_next_deadline(&t.line);
-
-		if (next == UINT64_MAX || next > at) {
-			break;
-		}
-		t.now = next;
-		co_line_process(&t.line, t.now);
-	}
-	t.now = at;
-	co_line_process(&t.line, t.now);
-}
-
-static void rx(uint32_t id, uint8_t dlc, const uint8_t *data)
-{
-	struct can_frame f = {.id = id, .dlc = dlc};
-
-	if (data != NULL) {
-		memcpy(f.data, data, dlc);
-	}
-	co_line_rx(&t.line, &f, t.now);
-}
-
-static void nmt(uint8_t cs)
-{
-	uint8_t d[2] = {cs, NODE_ID};
-
-	rx(0x000, 2, d);
-}
-
-static uint32_t od_write_u(uint16_t index, uint8_t sub, uint32_t value, size_t len)
-{
-	uint8_t buf[4];
-	uint32_t ab;
-
-	for (size_t i = 0; i < len; i++) {
-		buf[i] = (uint8_t)(value >> (8 * i));
-	}
-	co_node_lock(&t.node);
-	ab = co_od_write(co_node_od(&t.node), index, sub, buf, len, CO_OD_WRITER_SDO);
-	co_node_unlock(&t.node);
-	return ab;
 }
 
 static uint32_t od_read_u(uint16_t index, uint8_t sub)
@@ -143,8 +84,8 @@ static int emcy_frames(int *idx, int max)
 {
 	int n = 0;
 
-	for (int i = 0; i < t.n_sent; i++) {
-		if (t.sent[i].id == EMCY_ID && n < max) {
+	for (int i = 0; i < sim.n_sent; i++) {
+		if (sim.sent[i].id == EMCY_ID && n < max) {
 			idx[n++] = i;
 		}
 	}
@@ -155,23 +96,23 @@ static void assert_emcy(int i, uint32_t id, uint16_t code, uint8_t reg, const ui
 {
 	static const uint8_t zero[5];
 
-	zassert_true(i < t.n_sent, "frame %d missing (sent %d)", i, t.n_sent);
-	zassert_equal(t.sent[i].id, id, "frame %d id %x", i, t.sent[i].id);
-	zassert_equal(t.sent[i].dlc, 8, "EMCY DLC is 8");
-	zassert_equal(t.sent[i].data[0], (uint8_t)code, "code low byte first");
-	zassert_equal(t.sent[i].data[1], (uint8_t)(code >> 8));
-	zassert_equal(t.sent[i].data[2], reg, "frame %d register %02x", i, t.sent[i].data[2]);
-	zassert_mem_equal(&t.sent[i].data[3], msef != NULL ? msef : zero, 5);
+	zassert_true(i < sim.n_sent, "frame %d missing (sent %d)", i, sim.n_sent);
+	zassert_equal(sim.sent[i].id, id, "frame %d id %x", i, sim.sent[i].id);
+	zassert_equal(sim.sent[i].dlc, 8, "EMCY DLC is 8");
+	zassert_equal(sim.sent[i].data[0], (uint8_t)code, "code low byte first");
+	zassert_equal(sim.sent[i].data[1], (uint8_t)(code >> 8));
+	zassert_equal(sim.sent[i].data[2], reg, "frame %d register %02x", i, sim.sent[i].data[2]);
+	zassert_mem_equal(&sim.sent[i].data[3], msef != NULL ? msef : zero, 5);
 }
 
 static void before(void *f)
 {
 	memset(&t, 0, sizeof(t));
-	co_line_init_sim(&t.line, "sim", sink, NULL);
-	zassert_ok(co_node_init(&t.node, "dut", &t.line, &emcy_test_od_def, &t.ram, NODE_ID));
+	co_sim_init();
+	zassert_ok(co_node_init(&t.node, "dut", &sim.line, &emcy_test_od_def, &t.ram, NODE_ID));
 	co_emcy_set_ind(&t.node, emcy_ind, NULL);
 	zassert_ok(co_node_start(&t.node));
-	t.n_sent = 0; /* boot-up */
+	sim.n_sent = 0; /* boot-up */
 }
 
 ZTEST_SUITE(co_emcy, NULL, NULL, before, NULL, NULL);
@@ -182,7 +123,7 @@ ZTEST(co_emcy, test_frame_format_cob_80h_plus_node_id_dlc8_code_register_msef)
 
 	zassert_equal(od_read_u(0x1014, 0), EMCY_ID, "1014h default $NODEID+80h");
 	zassert_ok(co_emcy_raise(&t.node, 0x2310, CO_EMCY_REG_CURRENT, msef));
-	zassert_equal(t.n_sent, 1);
+	zassert_equal(sim.n_sent, 1);
 	assert_emcy(0, EMCY_ID, 0x2310, 0x03, msef);
 
 	zassert_ok(co_emcy_raise(&t.node, 0x5000, 0, NULL));
@@ -190,7 +131,7 @@ ZTEST(co_emcy, test_frame_format_cob_80h_plus_node_id_dlc8_code_register_msef)
 
 	zassert_equal(co_emcy_raise(&t.node, 0x0000, 0, NULL), -EINVAL, "0000h is not an error");
 	zassert_equal(co_emcy_clear(&t.node, 0x4210), -ENOENT);
-	zassert_equal(t.n_sent, 2);
+	zassert_equal(sim.n_sent, 2);
 }
 
 ZTEST(co_emcy, test_error_register_1001h_derived_from_active_errors)
@@ -213,7 +154,7 @@ ZTEST(co_emcy, test_error_register_1001h_derived_from_active_errors)
 	zassert_equal(od_read_u(0x1001, 0), 0x00);
 	zassert_false(co_emcy_is_active(&t.node, 0x6100));
 
-	zassert_equal(od_write_u(0x1001, 0, 0x00, 1), CO_SDO_AB_READONLY, "1001h is ro");
+	zassert_equal(co_sim_write(&t.node, 0x1001, 0, 0x00, 1), CO_SDO_AB_READONLY, "1001h is ro");
 }
 
 ZTEST(co_emcy, test_active_table_full_keeps_bits_until_last_clear)
@@ -222,7 +163,8 @@ ZTEST(co_emcy, test_active_table_full_keeps_bits_until_last_clear)
 		zassert_ok(co_emcy_raise(&t.node, 0x9000 + i, 0, NULL));
 	}
 	zassert_equal(co_emcy_raise(&t.node, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL), -ENOSPC);
-	zassert_equal(t.n_sent, CONFIG_CANOPEN_EMCY_ACTIVE_ERRORS + 1, "its frame still goes out");
+	zassert_equal(sim.n_sent, CONFIG_CANOPEN_EMCY_ACTIVE_ERRORS + 1,
+		      "its frame still goes out");
 	zassert_equal(od_read_u(0x1001, 0), 0x09, "and its bits show");
 	zassert_equal(co_emcy_clear(&t.node, 0x4210), -ENOENT, "not tracked individually");
 	for (uint16_t i = 0; i < CONFIG_CANOPEN_EMCY_ACTIVE_ERRORS - 1; i++) {
@@ -237,22 +179,22 @@ ZTEST(co_emcy, test_error_reset_frame_carries_remaining_register_and_zero_after_
 {
 	zassert_ok(co_emcy_raise(&t.node, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
 	zassert_ok(co_emcy_raise(&t.node, 0x2310, CO_EMCY_REG_CURRENT, NULL));
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	zassert_ok(co_emcy_clear(&t.node, 0x4210));
 	assert_emcy(0, EMCY_ID, 0x0000, 0x03, NULL);
 	zassert_ok(co_emcy_clear(&t.node, 0x2310));
 	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
-	zassert_equal(t.n_sent, 2);
+	zassert_equal(sim.n_sent, 2);
 }
 
 ZTEST(co_emcy, test_inhibit_time_defers_frames_spaced_and_none_lost)
 {
 	int idx[8];
 
-	zassert_equal(od_write_u(0x1015, 0, 100, 2), 0U, "100 x 100 us = 10 ms");
-	run_until(1000 * MS);
+	zassert_equal(co_sim_write(&t.node, 0x1015, 0, 100, 2), 0U, "100 x 100 us = 10 ms");
+	co_sim_run_until(1000 * MS);
 	zassert_ok(co_emcy_raise(&t.node, 0x1000, 0, NULL));
-	run_until(1002 * MS);
+	co_sim_run_until(1002 * MS);
 	zassert_ok(co_emcy_raise(&t.node, 0x2000, 0, NULL), "deferred, not an error");
 	zassert_ok(co_emcy_raise(&t.node, 0x3000, 0, NULL));
 	zassert_ok(co_emcy_clear(&t.node, 0x1000));
@@ -262,16 +204,16 @@ ZTEST(co_emcy, test_inhibit_time_defers_frames_spaced_and_none_lost)
 	co_emcy_get_status(&t.node, &st);
 	zassert_equal(st.queued, 3);
 	zassert_equal(emcy_frames(idx, 8), 1, "only the first goes out at once");
-	run_until(1100 * MS);
+	co_sim_run_until(1100 * MS);
 	zassert_equal(emcy_frames(idx, 8), 4, "every deferred frame is sent");
-	zassert_equal(t.sent[idx[1]].data[1], 0x20, "in order");
-	zassert_equal(t.sent[idx[2]].data[1], 0x30);
-	zassert_equal(t.sent[idx[3]].data[1], 0x00, "then the error reset");
+	zassert_equal(sim.sent[idx[1]].data[1], 0x20, "in order");
+	zassert_equal(sim.sent[idx[2]].data[1], 0x30);
+	zassert_equal(sim.sent[idx[3]].data[1], 0x00, "then the error reset");
 	for (int i = 1; i < 4; i++) {
-		zassert_true(t.sent_at[idx[i]] - t.sent_at[idx[i - 1]] >= 10 * MS,
+		zassert_true(sim.sent_at[idx[i]] - sim.sent_at[idx[i - 1]] >= 10 * MS,
 			     "frames %d and %d closer than 1015h", i - 1, i);
 	}
-	zassert_equal(t.sent_at[idx[1]], 1010 * MS, "sent as soon as the inhibit expires");
+	zassert_equal(sim.sent_at[idx[1]], 1010 * MS, "sent as soon as the inhibit expires");
 	co_emcy_get_status(&t.node, &st);
 	zassert_equal(st.queued, 0);
 	zassert_equal(st.overflows, 0);
@@ -282,7 +224,7 @@ ZTEST(co_emcy, test_inhibit_queue_overflow_is_counted_and_recorded)
 	struct co_emcy_status st;
 	int idx[16];
 
-	zassert_equal(od_write_u(0x1015, 0, 100, 2), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1015, 0, 100, 2), 0U);
 	/* One sent, CONFIG_CANOPEN_EMCY_QUEUE queued, the rest overflow. */
 	for (uint16_t i = 0; i < CONFIG_CANOPEN_EMCY_QUEUE + 3; i++) {
 		zassert_ok(co_emcy_raise(&t.node, 0x1000 + i, 0, NULL));
@@ -292,7 +234,7 @@ ZTEST(co_emcy, test_inhibit_queue_overflow_is_counted_and_recorded)
 	zassert_equal(st.overflows, 2);
 	zassert_equal(od_read_u(0x1003, 1), 0x1000U + CONFIG_CANOPEN_EMCY_QUEUE + 2,
 		      "1003h still records the lost frame's error");
-	run_until(1000 * MS);
+	co_sim_run_until(1000 * MS);
 	zassert_equal(emcy_frames(idx, 16), CONFIG_CANOPEN_EMCY_QUEUE + 1);
 }
 
@@ -322,10 +264,10 @@ ZTEST(co_emcy, test_history_write_zero_clears_other_writes_refused_06090030h)
 {
 	zassert_ok(co_emcy_raise(&t.node, 0x4210, 0, NULL));
 	zassert_ok(co_emcy_raise(&t.node, 0x4220, 0, NULL));
-	zassert_equal(od_write_u(0x1003, 0, 1, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1003, 0, 1, 1), CO_SDO_AB_INVALID_VALUE);
 	zassert_equal(od_read_u(0x1003, 0), 2, "refused write changes nothing");
-	zassert_equal(od_write_u(0x1003, 1, 0, 4), CO_SDO_AB_READONLY, "entries are ro");
-	zassert_equal(od_write_u(0x1003, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1003, 1, 0, 4), CO_SDO_AB_READONLY, "entries are ro");
+	zassert_equal(co_sim_write(&t.node, 0x1003, 0, 0, 1), 0U);
 	zassert_equal(od_read_u(0x1003, 0), 0);
 	zassert_equal(od_read_app(0x1003, 1), 0, "entries cleared");
 	zassert_true(co_emcy_is_active(&t.node, 0x4210), "clearing history clears no error");
@@ -336,25 +278,28 @@ ZTEST(co_emcy, test_history_write_zero_clears_other_writes_refused_06090030h)
 
 ZTEST(co_emcy, test_cob_id_1014h_write_rules_and_invalid_bit)
 {
-	zassert_equal(od_write_u(0x1014, 0, 0x0a0, 4), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x0a0, 4), CO_SDO_AB_INVALID_VALUE,
 		      "CAN-ID cannot change while valid");
-	zassert_equal(od_write_u(0x1014, 0, EMCY_ID, 4), 0U, "same value is fine");
-	zassert_equal(od_write_u(0x1014, 0, 0x80000000U | EMCY_ID, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, EMCY_ID, 4), 0U, "same value is fine");
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x80000000U | EMCY_ID, 4), 0U);
 	zassert_ok(co_emcy_raise(&t.node, 0x5000, 0, NULL));
-	zassert_equal(t.n_sent, 0, "no EMCY while 1014h bit 31 is set");
+	zassert_equal(sim.n_sent, 0, "no EMCY while 1014h bit 31 is set");
 	zassert_equal(od_read_u(0x1001, 0), 0x01, "the error is still recorded");
 
-	zassert_equal(od_write_u(0x1014, 0, 0x80000000U | 0x0a0, 4), 0U,
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x80000000U | 0x0a0, 4), 0U,
 		      "CAN-ID may change while invalid");
-	zassert_equal(od_write_u(0x1014, 0, 0x0a0, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x0a0, 4), 0U);
 	zassert_ok(co_emcy_raise(&t.node, 0x5001, 0, NULL));
 	assert_emcy(0, 0x0a0, 0x5001, 0x01, NULL);
 
-	zassert_equal(od_write_u(0x1014, 0, 0x80000000U, 4), 0U);
-	zassert_equal(od_write_u(0x1014, 0, 0x701, 4), CO_SDO_AB_INVALID_VALUE, "restricted");
-	zassert_equal(od_write_u(0x1014, 0, 0x581, 4), CO_SDO_AB_INVALID_VALUE, "restricted");
-	zassert_equal(od_write_u(0x1014, 0, 0x000, 4), CO_SDO_AB_INVALID_VALUE, "restricted");
-	zassert_equal(od_write_u(0x1014, 0, 0x20000123, 4), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x80000000U, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x701, 4), CO_SDO_AB_INVALID_VALUE,
+		      "restricted");
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x581, 4), CO_SDO_AB_INVALID_VALUE,
+		      "restricted");
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x000, 4), CO_SDO_AB_INVALID_VALUE,
+		      "restricted");
+	zassert_equal(co_sim_write(&t.node, 0x1014, 0, 0x20000123, 4), CO_SDO_AB_INVALID_VALUE,
 		      "29-bit not supported");
 }
 
@@ -362,11 +307,11 @@ ZTEST(co_emcy, test_consumer_1028h_indication_and_dlc_check)
 {
 	const uint8_t good[8] = {0x30, 0x81, 0x11, 1, 2, 3, 4, 5};
 
-	rx(0x85, 8, good);
+	co_sim_rx(0x85, 8, good);
 	zassert_equal(t.n_ind, 0, "1028h entries invalid by default");
-	zassert_equal(od_write_u(0x1028, 1, 0x85, 4), 0U);
-	zassert_equal(od_write_u(0x1028, 2, 0x0ff, 4), 0U);
-	rx(0x85, 8, good);
+	zassert_equal(co_sim_write(&t.node, 0x1028, 1, 0x85, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1028, 2, 0x0ff, 4), 0U);
+	co_sim_rx(0x85, 8, good);
 	zassert_equal(t.n_ind, 1);
 	zassert_equal(t.ind_cob[0], 0x85);
 	zassert_equal(t.ind_remote[0], 5);
@@ -374,21 +319,21 @@ ZTEST(co_emcy, test_consumer_1028h_indication_and_dlc_check)
 	zassert_equal(t.ind_reg[0], 0x11);
 	zassert_mem_equal(t.ind_msef[0], &good[3], 5);
 
-	rx(0x85, 7, good);
-	rx(0x85, 0, NULL);
+	co_sim_rx(0x85, 7, good);
+	co_sim_rx(0x85, 0, NULL);
 	zassert_equal(t.n_ind, 1, "DLC != 8 ignored");
-	rx(0x86, 8, good);
+	co_sim_rx(0x86, 8, good);
 	zassert_equal(t.n_ind, 1, "COB-ID not in 1028h ignored");
-	rx(0xff, 8, good);
+	co_sim_rx(0xff, 8, good);
 	zassert_equal(t.n_ind, 2);
 	zassert_equal(t.ind_remote[1], 0x7f);
 
-	zassert_equal(od_write_u(0x1028, 1, 0x80000085U, 4), 0U);
-	rx(0x85, 8, good);
+	zassert_equal(co_sim_write(&t.node, 0x1028, 1, 0x80000085U, 4), 0U);
+	co_sim_rx(0x85, 8, good);
 	zassert_equal(t.n_ind, 2, "entry made invalid");
 
-	nmt(CO_NMT_CS_STOP);
-	rx(0xff, 8, good);
+	co_sim_nmt(CO_NMT_CS_STOP, NODE_ID);
+	co_sim_rx(0xff, 8, good);
 	zassert_equal(t.n_ind, 2, "no EMCY consumption in Stopped");
 }
 
@@ -397,14 +342,14 @@ static void lose_heartbeat(void)
 {
 	uint8_t op = 0x05;
 
-	zassert_equal(od_write_u(0x1016, 1, (5U << 16) | 100U, 4), 0U);
-	nmt(CO_NMT_CS_START);
+	zassert_equal(co_sim_write(&t.node, 0x1016, 1, (5U << 16) | 100U, 4), 0U);
+	co_sim_nmt(CO_NMT_CS_START, NODE_ID);
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_OPERATIONAL);
-	rx(0x705, 1, &op);
-	t.n_sent = 0;
-	run_until(t.now + 99 * MS);
-	zassert_equal(t.n_sent, 0, "nothing before the consumer time");
-	run_until(t.now + 1 * MS);
+	co_sim_rx(0x705, 1, &op);
+	sim.n_sent = 0;
+	co_sim_run_until(sim.now + 99 * MS);
+	zassert_equal(sim.n_sent, 0, "nothing before the consumer time");
+	co_sim_run_until(sim.now + 1 * MS);
 }
 
 ZTEST(co_emcy, test_heartbeat_loss_8130h_and_1029h_0_goes_pre_operational)
@@ -419,8 +364,8 @@ ZTEST(co_emcy, test_heartbeat_loss_8130h_and_1029h_0_goes_pre_operational)
 	zassert_equal(od_read_u(0x1001, 0), 0x11, "generic + communication");
 	zassert_equal(od_read_u(0x1003, 1), 0x00058130U, "info = the lost node-ID");
 
-	rx(0x705, 1, &op);
-	zassert_equal(t.n_sent, 2, "recovery sends the error reset");
+	co_sim_rx(0x705, 1, &op);
+	zassert_equal(sim.n_sent, 2, "recovery sends the error reset");
 	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
 	zassert_false(co_emcy_is_active(&t.node, 0x8130));
 }
@@ -429,16 +374,16 @@ ZTEST(co_emcy, test_heartbeat_loss_1029h_0_in_pre_operational_stays)
 {
 	uint8_t op = 0x05;
 
-	zassert_equal(od_write_u(0x1016, 1, (5U << 16) | 100U, 4), 0U);
-	rx(0x705, 1, &op);
-	run_until(200 * MS);
+	zassert_equal(co_sim_write(&t.node, 0x1016, 1, (5U << 16) | 100U, 4), 0U);
+	co_sim_rx(0x705, 1, &op);
+	co_sim_run_until(200 * MS);
 	assert_emcy(0, EMCY_ID, 0x8130, 0x11, (const uint8_t[5]){5});
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL);
 }
 
 ZTEST(co_emcy, test_heartbeat_loss_1029h_1_no_state_change)
 {
-	zassert_equal(od_write_u(0x1029, 1, 1, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 1, 1), 0U);
 	lose_heartbeat();
 	assert_emcy(0, EMCY_ID, 0x8130, 0x11, (const uint8_t[5]){5});
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_OPERATIONAL);
@@ -446,7 +391,7 @@ ZTEST(co_emcy, test_heartbeat_loss_1029h_1_no_state_change)
 
 ZTEST(co_emcy, test_heartbeat_loss_1029h_2_goes_stopped_after_sending_emcy)
 {
-	zassert_equal(od_write_u(0x1029, 1, 2, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 2, 1), 0U);
 	lose_heartbeat();
 	assert_emcy(0, EMCY_ID, 0x8130, 0x11, (const uint8_t[5]){5});
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_STOPPED);
@@ -456,54 +401,54 @@ ZTEST(co_emcy, test_two_lost_heartbeats_clear_8130h_only_when_both_recover)
 {
 	uint8_t op = 0x05;
 
-	zassert_equal(od_write_u(0x1029, 1, 1, 1), 0U);
-	zassert_equal(od_write_u(0x1016, 1, (5U << 16) | 100U, 4), 0U);
-	zassert_equal(od_write_u(0x1016, 2, (6U << 16) | 100U, 4), 0U);
-	rx(0x705, 1, &op);
-	rx(0x706, 1, &op);
-	run_until(100 * MS);
-	zassert_equal(t.n_sent, 1, "one EMCY for the active code");
-	rx(0x705, 1, &op);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 1, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1016, 1, (5U << 16) | 100U, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1016, 2, (6U << 16) | 100U, 4), 0U);
+	co_sim_rx(0x705, 1, &op);
+	co_sim_rx(0x706, 1, &op);
+	co_sim_run_until(100 * MS);
+	zassert_equal(sim.n_sent, 1, "one EMCY for the active code");
+	co_sim_rx(0x705, 1, &op);
 	zassert_true(co_emcy_is_active(&t.node, 0x8130), "node 6 still lost");
-	zassert_equal(t.n_sent, 1);
-	rx(0x706, 1, &op);
+	zassert_equal(sim.n_sent, 1);
+	co_sim_rx(0x706, 1, &op);
 	zassert_false(co_emcy_is_active(&t.node, 0x8130));
 	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
 }
 
 ZTEST(co_emcy, test_life_guarding_event_raises_8130h)
 {
-	zassert_equal(od_write_u(0x1029, 1, 1, 1), 0U);
-	zassert_equal(od_write_u(0x100C, 0, 100, 2), 0U);
-	zassert_equal(od_write_u(0x100D, 0, 3, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 1, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x100C, 0, 100, 2), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x100D, 0, 3, 1), 0U);
 	struct can_frame rtr = {.id = 0x700 + NODE_ID, .flags = CAN_FRAME_RTR, .dlc = 1};
 
-	co_line_rx(&t.line, &rtr, t.now);
-	t.n_sent = 0;
-	run_until(299 * MS);
-	zassert_equal(t.n_sent, 0, "nothing within the node life time");
-	run_until(300 * MS);
+	co_line_rx(&sim.line, &rtr, sim.now);
+	sim.n_sent = 0;
+	co_sim_run_until(299 * MS);
+	zassert_equal(sim.n_sent, 0, "nothing within the node life time");
+	co_sim_run_until(300 * MS);
 	assert_emcy(0, EMCY_ID, 0x8130, 0x11, NULL);
 	zassert_true(co_emcy_is_active(&t.node, 0x8130));
 
-	co_line_rx(&t.line, &rtr, t.now);
+	co_line_rx(&sim.line, &rtr, sim.now);
 	zassert_false(co_emcy_is_active(&t.node, 0x8130), "guarding resumed");
 	assert_emcy(2, EMCY_ID, 0x0000, 0x00, NULL);
 }
 
 ZTEST(co_emcy, test_emcy_silent_in_stopped_but_recorded)
 {
-	nmt(CO_NMT_CS_STOP);
-	t.n_sent = 0;
+	co_sim_nmt(CO_NMT_CS_STOP, NODE_ID);
+	sim.n_sent = 0;
 	zassert_ok(co_emcy_raise(&t.node, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
-	zassert_equal(t.n_sent, 0, "no EMCY in Stopped");
+	zassert_equal(sim.n_sent, 0, "no EMCY in Stopped");
 	zassert_equal(od_read_u(0x1001, 0), 0x09);
 	zassert_equal(od_read_u(0x1003, 1), 0x4210);
 	zassert_ok(co_emcy_clear(&t.node, 0x4210));
-	zassert_equal(t.n_sent, 0);
+	zassert_equal(sim.n_sent, 0);
 
-	nmt(CO_NMT_CS_ENTER_PRE_OPERATIONAL);
-	zassert_equal(t.n_sent, 0, "not sent later either");
+	co_sim_nmt(CO_NMT_CS_ENTER_PRE_OPERATIONAL, NODE_ID);
+	zassert_equal(sim.n_sent, 0, "not sent later either");
 	zassert_ok(co_emcy_raise(&t.node, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
 	assert_emcy(0, EMCY_ID, 0x4210, 0x09, NULL);
 }
@@ -512,20 +457,20 @@ ZTEST(co_emcy, test_stopped_drops_frames_waiting_for_inhibit)
 {
 	struct co_emcy_status st;
 
-	zassert_equal(od_write_u(0x1015, 0, 100, 2), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1015, 0, 100, 2), 0U);
 	zassert_ok(co_emcy_raise(&t.node, 0x1000, 0, NULL));
 	zassert_ok(co_emcy_raise(&t.node, 0x2000, 0, NULL));
-	nmt(CO_NMT_CS_STOP);
+	co_sim_nmt(CO_NMT_CS_STOP, NODE_ID);
 	co_emcy_get_status(&t.node, &st);
 	zassert_equal(st.queued, 0);
-	run_until(100 * MS);
-	zassert_equal(t.n_sent, 1);
+	co_sim_run_until(100 * MS);
+	zassert_equal(sim.n_sent, 1);
 }
 
 ZTEST(co_emcy, test_reset_communication_keeps_application_errors_drops_history)
 {
 	zassert_ok(co_emcy_raise(&t.node, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
-	nmt(CO_NMT_CS_RESET_COMMUNICATION);
+	co_sim_nmt(CO_NMT_CS_RESET_COMMUNICATION, NODE_ID);
 	zassert_equal(od_read_u(0x1003, 0), 0, "1003h reloaded");
 	zassert_equal(od_read_u(0x1001, 0), 0x09, "the error is still there");
 	zassert_true(co_emcy_is_active(&t.node, 0x4210));
@@ -541,22 +486,22 @@ ZTEST(co_emcy, test_node_without_emcy_objects_tracks_errors_and_sends_nothing)
 	uint8_t op = 0x05;
 	uint8_t entry[4] = {0x64, 0x00, 0x05, 0x00}; /* 1016h: node 5, 100 ms */
 
-	zassert_ok(co_node_init(&bare, "bare", &t.line, &emcy_bare_od_def, &bare_ram, 0x22));
+	zassert_ok(co_node_init(&bare, "bare", &sim.line, &emcy_bare_od_def, &bare_ram, 0x22));
 	zassert_ok(co_node_start(&bare));
 	zassert_ok(
 		co_od_write(co_node_od(&bare), 0x1017, 0, (uint8_t[]){0, 0}, 2, CO_OD_WRITER_SDO));
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	zassert_ok(co_emcy_raise(&bare, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
 	zassert_ok(co_od_read(co_node_od(&bare), 0x1001, 0, 0, &reg, 1, &len, CO_OD_WRITER_SDO));
 	zassert_equal(reg, 0x09);
 	zassert_ok(co_emcy_clear(&bare, 0x4210));
-	zassert_equal(t.n_sent, 0, "no 1014h: no EMCY producer");
+	zassert_equal(sim.n_sent, 0, "no 1014h: no EMCY producer");
 
 	/* Lose node 5's heartbeat in Operational: the default 1029h behaviour applies. */
 	zassert_ok(co_od_write(co_node_od(&bare), 0x1016, 1, entry, 4, CO_OD_WRITER_SDO));
 	zassert_ok(co_nmt_req(&bare, CO_NMT_CS_START));
-	rx(0x705, 1, &op);
-	run_until(t.now + 100 * MS);
+	co_sim_rx(0x705, 1, &op);
+	co_sim_run_until(sim.now + 100 * MS);
 	zassert_true(co_emcy_is_active(&bare, 0x8130));
 	zassert_equal(co_nmt_get_state(&bare), CO_NMT_PRE_OPERATIONAL,
 		      "without 1029h a communication error leaves Operational");
@@ -566,28 +511,28 @@ ZTEST(co_emcy, test_node_without_emcy_objects_tracks_errors_and_sends_nothing)
 
 static void line_event(enum co_line_event ev, int arg)
 {
-	co_line_inject_event(&t.line, ev, arg);
+	co_line_inject_event(&sim.line, ev, arg);
 }
 
 ZTEST(co_emcy, test_rx_overrun_raises_8110h_once_then_clears_after_hold_time)
 {
 	const uint8_t rx_info[5] = {CO_EMCY_OVERRUN_RX};
 
-	t.now = 10 * MS;
-	co_line_process(&t.line, t.now);
+	sim.now = 10 * MS;
+	co_line_process(&sim.line, sim.now);
 	line_event(CO_LINE_EV_RX_OVERRUN, 0);
 	assert_emcy(0, EMCY_ID, 0x8110, 0x11, rx_info);
 	zassert_equal(od_read_u(0x1001, 0), 0x11, "generic + communication");
 	zassert_equal(od_read_u(0x1003, 1), 0x00018110U, "1003h info 01h = RX queue");
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL, "1029h not applied");
 
-	run_until(500 * MS);
+	co_sim_run_until(500 * MS);
 	line_event(CO_LINE_EV_RX_OVERRUN, 0);
-	zassert_equal(t.n_sent, 1, "one 8110h while it lasts");
-	run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS - 1);
-	zassert_equal(t.n_sent, 1, "each overrun restarts the hold time");
-	run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
-	zassert_equal(t.n_sent, 2);
+	zassert_equal(sim.n_sent, 1, "one 8110h while it lasts");
+	co_sim_run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS - 1);
+	zassert_equal(sim.n_sent, 1, "each overrun restarts the hold time");
+	co_sim_run_until(500 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
+	zassert_equal(sim.n_sent, 2);
 	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
 	zassert_false(co_emcy_is_active(&t.node, 0x8110));
 }
@@ -597,9 +542,9 @@ ZTEST(co_emcy, test_tx_overflow_raises_8110h_from_the_line_thread)
 	const uint8_t tx_info[5] = {CO_EMCY_OVERRUN_TX};
 
 	/* As co_line_send() reports it: deferred to the line thread's next pass. */
-	co_line_report_from_send(&t.line, CO_LINE_EV_TX_OVERFLOW, 0);
-	zassert_equal(t.n_sent, 0, "not from the sender's context");
-	co_line_process(&t.line, t.now);
+	co_line_report_from_send(&sim.line, CO_LINE_EV_TX_OVERFLOW, 0);
+	zassert_equal(sim.n_sent, 0, "not from the sender's context");
+	co_line_process(&sim.line, sim.now);
 	assert_emcy(0, EMCY_ID, 0x8110, 0x11, tx_info);
 	zassert_equal(od_read_u(0x1003, 1), 0x00028110U);
 }
@@ -607,14 +552,14 @@ ZTEST(co_emcy, test_tx_overflow_raises_8110h_from_the_line_thread)
 ZTEST(co_emcy, test_error_passive_raises_8120h_cleared_when_error_active)
 {
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_WARNING);
-	zassert_equal(t.n_sent, 0, "warning is still error active");
+	zassert_equal(sim.n_sent, 0, "warning is still error active");
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	assert_emcy(0, EMCY_ID, 0x8120, 0x11, NULL);
 	zassert_true(co_emcy_is_active(&t.node, 0x8120));
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
-	zassert_equal(t.n_sent, 1, "same state, nothing new");
+	zassert_equal(sim.n_sent, 1, "same state, nothing new");
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_WARNING);
-	zassert_equal(t.n_sent, 2);
+	zassert_equal(sim.n_sent, 2);
 	assert_emcy(1, EMCY_ID, 0x0000, 0x00, NULL);
 	zassert_equal(od_read_u(0x1001, 0), 0x00);
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL);
@@ -622,42 +567,42 @@ ZTEST(co_emcy, test_error_passive_raises_8120h_cleared_when_error_active)
 
 ZTEST(co_emcy, test_bus_off_applies_1029h_and_recovery_raises_8140h)
 {
-	nmt(0x01); /* Operational */
-	t.n_sent = 0;
-	t.now = 20 * MS;
-	co_line_process(&t.line, t.now);
+	co_sim_nmt(0x01, NODE_ID); /* Operational */
+	sim.n_sent = 0;
+	sim.now = 20 * MS;
+	co_line_process(&sim.line, sim.now);
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	assert_emcy(0, EMCY_ID, 0x8120, 0x11, NULL);
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL,
 		      "1029h sub1 = 0: bus-off sends Operational to Pre-operational");
-	zassert_equal(t.n_sent, 1, "nothing to send while bus-off");
+	zassert_equal(sim.n_sent, 1, "nothing to send while bus-off");
 
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
-	zassert_equal(t.n_sent, 3);
+	zassert_equal(sim.n_sent, 3);
 	assert_emcy(1, EMCY_ID, 0x8140, 0x11, NULL);
 	assert_emcy(2, EMCY_ID, 0x0000, 0x11, NULL); /* 8120h cleared, 8140h still held */
 	zassert_equal(od_read_u(0x1003, 1), 0x00008140U);
 	zassert_true(co_emcy_is_active(&t.node, 0x8140));
 	zassert_false(co_emcy_is_active(&t.node, 0x8120));
 
-	run_until(20 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
-	zassert_equal(t.n_sent, 4);
+	co_sim_run_until(20 * MS + CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * MS);
+	zassert_equal(sim.n_sent, 4);
 	assert_emcy(3, EMCY_ID, 0x0000, 0x00, NULL);
 	zassert_equal(od_read_u(0x1001, 0), 0x00);
 }
 
 ZTEST(co_emcy, test_bus_off_1029h_1_and_2)
 {
-	nmt(0x01);
-	zassert_equal(od_write_u(0x1029, 1, 1, 1), 0U);
+	co_sim_nmt(0x01, NODE_ID);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 1, 1), 0U);
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_OPERATIONAL, "1: no change");
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	zassert_true(co_emcy_is_active(&t.node, 0x8140), "recovered into error passive");
 	zassert_true(co_emcy_is_active(&t.node, 0x8120));
 
-	zassert_equal(od_write_u(0x1029, 1, 2, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1029, 1, 2, 1), 0U);
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_STOPPED, "2: Stopped");
 }
@@ -667,11 +612,11 @@ ZTEST(co_emcy, test_reset_communication_keeps_8120h_while_still_passive)
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	line_event(CO_LINE_EV_RX_OVERRUN, 0);
 	zassert_equal(od_read_u(0x1001, 0), 0x11);
-	nmt(0x82); /* Reset communication */
+	co_sim_nmt(0x82, NODE_ID); /* Reset communication */
 	zassert_true(co_emcy_is_active(&t.node, 0x8120), "still passive");
 	zassert_false(co_emcy_is_active(&t.node, 0x8110), "an event error restarts");
 	zassert_equal(od_read_u(0x1001, 0), 0x11);
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
 	assert_emcy(0, EMCY_ID, 0x0000, 0x00, NULL);
 }
@@ -681,7 +626,7 @@ static void app_event_cb(struct co_line *line, enum co_line_event event, int arg
 	int *calls = user_data;
 
 	/* The application's callback runs first, without the node's lock. */
-	zassert_equal(t.n_sent, 0);
+	zassert_equal(sim.n_sent, 0);
 	calls[0]++;
 	calls[1] = arg;
 }
@@ -690,12 +635,12 @@ ZTEST(co_emcy, test_application_line_callback_still_called)
 {
 	int calls[2] = {0};
 
-	co_line_set_event_cb(&t.line, app_event_cb, calls);
+	co_line_set_event_cb(&sim.line, app_event_cb, calls);
 	line_event(CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	zassert_equal(calls[0], 1);
 	zassert_equal(calls[1], CAN_STATE_ERROR_PASSIVE);
-	zassert_equal(t.n_sent, 1, "and the node's listener too");
-	co_line_set_event_cb(&t.line, NULL, NULL);
+	zassert_equal(sim.n_sent, 1, "and the node's listener too");
+	co_line_set_event_cb(&sim.line, NULL, NULL);
 }
 
 ZTEST(co_emcy, test_history_read_beyond_count_aborts_08000024h)
@@ -714,7 +659,7 @@ ZTEST(co_emcy, test_history_read_beyond_count_aborts_08000024h)
 			CO_OD_WRITER_SDO);
 	co_node_unlock(&t.node);
 	zassert_equal(ab, CO_SDO_AB_NO_DATA, "sub3 > count 2: %08x", ab);
-	zassert_equal(od_write_u(0x1003, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1003, 0, 0, 1), 0U);
 	co_node_lock(&t.node);
 	ab = co_od_read(co_node_od(&t.node), 0x1003, 1, 0, buf, sizeof(buf), &len,
 			CO_OD_WRITER_SDO);

@@ -22,6 +22,7 @@
 #include <canopen/sdo_abort.h>
 #include <canopen/sync.h>
 
+#include "co_sim.h"
 #include "pdo_test_od.h"
 
 #define NODE_ID 0x21
@@ -34,27 +35,14 @@
 #define NO_RTR  0x40000000U
 
 static struct {
-	struct co_line line;
 	struct co_node node;
 	struct pdo_test_od_ram ram;
-	struct can_frame sent[MAX_TX];
-	uint64_t sent_at[MAX_TX];
-	int n_sent;
-	uint64_t now;
 	int n_rpdo_ind;
 	uint16_t rpdo_ind_num;
 	int n_tpdo_ind;
 	uint8_t pre_seen;
 	uint8_t post_seen;
 } t;
-
-static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
-{
-	zassert_true(t.n_sent < MAX_TX, "too many frames");
-	t.sent_at[t.n_sent] = t.now;
-	t.sent[t.n_sent++] = *frame;
-	return 0;
-}
 
 static void rpdo_ind(struct co_node *node, uint16_t num, void *user_data)
 {
@@ -85,67 +73,21 @@ static void post_sync(struct co_node *node, uint8_t counter, void *user_data)
 	t.post_seen = get_u8(0x2000, 1);
 }
 
-static void run_until(uint64_t at)
-{
-	while (true) {
-		uint64_t next = co_line_next_deadline(&t.line);
-
-		if (next == UINT64_MAX || next > at) {
-			break;
-		}
-		t.now = next;
-		co_line_process(&t.line, t.now);
-	}
-	t.now = at;
-	co_line_process(&t.line, t.now);
-}
-
-static void rx(uint32_t id, uint8_t dlc, const uint8_t *data)
-{
-	struct can_frame f = {.id = id, .dlc = dlc};
-
-	if (data != NULL) {
-		memcpy(f.data, data, dlc);
-	}
-	co_line_rx(&t.line, &f, t.now);
-}
-
 static void rx_rtr(uint32_t id, uint8_t dlc)
 {
 	struct can_frame f = {.id = id, .dlc = dlc, .flags = CAN_FRAME_RTR};
 
-	co_line_rx(&t.line, &f, t.now);
+	co_line_rx(&sim.line, &f, sim.now);
 }
 
 static void sync_rx(void)
 {
-	rx(SYNC_ID, 0, NULL);
+	co_sim_rx(SYNC_ID, 0, NULL);
 }
 
 static void sync_rx_counter(uint8_t c)
 {
-	rx(SYNC_ID, 1, &c);
-}
-
-static void nmt(uint8_t cs)
-{
-	uint8_t d[2] = {cs, NODE_ID};
-
-	rx(0x000, 2, d);
-}
-
-static uint32_t wr(uint16_t index, uint8_t sub, uint32_t value, size_t len)
-{
-	uint8_t buf[4];
-	uint32_t ab;
-
-	for (size_t i = 0; i < len; i++) {
-		buf[i] = (uint8_t)(value >> (8 * i));
-	}
-	co_node_lock(&t.node);
-	ab = co_od_write(co_node_od(&t.node), index, sub, buf, len, CO_OD_WRITER_SDO);
-	co_node_unlock(&t.node);
-	return ab;
+	co_sim_rx(SYNC_ID, 1, &c);
 }
 
 static void app_u8(uint16_t index, uint8_t sub, uint8_t v)
@@ -166,8 +108,8 @@ static int count(uint32_t id)
 {
 	int n = 0;
 
-	for (int i = 0; i < t.n_sent; i++) {
-		n += t.sent[i].id == id;
+	for (int i = 0; i < sim.n_sent; i++) {
+		n += sim.sent[i].id == id;
 	}
 	return n;
 }
@@ -175,9 +117,9 @@ static int count(uint32_t id)
 /* The k-th (0-based) frame sent with @p id, or NULL. */
 static const struct can_frame *nth(uint32_t id, int k)
 {
-	for (int i = 0; i < t.n_sent; i++) {
-		if (t.sent[i].id == id && k-- == 0) {
-			return &t.sent[i];
+	for (int i = 0; i < sim.n_sent; i++) {
+		if (sim.sent[i].id == id && k-- == 0) {
+			return &sim.sent[i];
 		}
 	}
 	return NULL;
@@ -185,9 +127,9 @@ static const struct can_frame *nth(uint32_t id, int k)
 
 static uint64_t nth_at(uint32_t id, int k)
 {
-	for (int i = 0; i < t.n_sent; i++) {
-		if (t.sent[i].id == id && k-- == 0) {
-			return t.sent_at[i];
+	for (int i = 0; i < sim.n_sent; i++) {
+		if (sim.sent[i].id == id && k-- == 0) {
+			return sim.sent_at[i];
 		}
 	}
 	return UINT64_MAX;
@@ -208,33 +150,33 @@ static void setup_pdo(bool rx_pdo, int n, uint32_t cob, uint8_t type, const uint
 	uint16_t comm = (rx_pdo ? 0x1400 : 0x1800) + n;
 	uint16_t mapi = (rx_pdo ? 0x1600 : 0x1A00) + n;
 
-	zassert_equal(wr(comm, 1, cob | INVALID, 4), 0U);
-	zassert_equal(wr(mapi, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, comm, 1, cob | INVALID, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, mapi, 0, 0, 1), 0U);
 	for (uint8_t i = 0; i < n_map; i++) {
-		zassert_equal(wr(mapi, i + 1, map[i], 4), 0U, "entry %u", i + 1);
+		zassert_equal(co_sim_write(&t.node, mapi, i + 1, map[i], 4), 0U, "entry %u", i + 1);
 	}
-	zassert_equal(wr(mapi, 0, n_map, 1), 0U);
-	zassert_equal(wr(comm, 2, type, 1), 0U);
-	zassert_equal(wr(comm, 1, cob, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, mapi, 0, n_map, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, comm, 2, type, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, comm, 1, cob, 4), 0U);
 }
 
 static void before(void *f)
 {
 	memset(&t, 0, sizeof(t));
-	co_line_init_sim(&t.line, "sim", sink, NULL);
-	zassert_ok(co_node_init(&t.node, "dut", &t.line, &pdo_test_od_def, &t.ram, NODE_ID));
+	co_sim_init();
+	zassert_ok(co_node_init(&t.node, "dut", &sim.line, &pdo_test_od_def, &t.ram, NODE_ID));
 	co_rpdo_set_ind(&t.node, rpdo_ind, NULL);
 	co_tpdo_set_ind(&t.node, tpdo_ind, NULL);
 	co_sync_set_ind(&t.node, pre_sync, NULL);
 	co_sync_set_post_ind(&t.node, post_sync, NULL);
 	zassert_ok(co_node_start(&t.node));
-	t.n_sent = 0; /* boot-up */
+	sim.n_sent = 0; /* boot-up */
 }
 
 static void go_operational(void)
 {
-	nmt(0x01);
-	t.n_sent = 0;
+	co_sim_nmt(0x01, NODE_ID);
+	sim.n_sent = 0;
 }
 
 ZTEST_SUITE(co_pdo, NULL, NULL, before, NULL, NULL);
@@ -246,68 +188,68 @@ ZTEST(co_pdo, test_rpdo_applied_only_in_operational)
 	const uint8_t d[3] = {0x11, 0x34, 0x12};
 	uint16_t w = 0;
 
-	rx(0x200 + NODE_ID, 3, d);
+	co_sim_rx(0x200 + NODE_ID, 3, d);
 	zassert_equal(get_u8(0x2000, 1), 0, "RPDO in Pre-operational is ignored");
 	zassert_equal(t.n_rpdo_ind, 0);
 
 	go_operational();
-	rx(0x200 + NODE_ID, 3, d);
+	co_sim_rx(0x200 + NODE_ID, 3, d);
 	zassert_equal(get_u8(0x2000, 1), 0x11);
 	zassert_ok(co_od_get_u16(co_node_od(&t.node), 0x2001, 0, &w));
 	zassert_equal(w, 0x1234, "little endian");
 	zassert_equal(t.n_rpdo_ind, 1);
 	zassert_equal(t.rpdo_ind_num, 0);
 
-	nmt(0x02); /* Stopped */
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x22, 0, 0});
+	co_sim_nmt(0x02, NODE_ID); /* Stopped */
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x22, 0, 0});
 	zassert_equal(get_u8(0x2000, 1), 0x11, "RPDO in Stopped is ignored");
-	zassert_equal(t.n_sent, 0, "nothing sent");
+	zassert_equal(sim.n_sent, 0, "nothing sent");
 }
 
 ZTEST(co_pdo, test_rpdo_length_errors_emcy_8210h_8220h)
 {
 	go_operational();
-	rx(0x200 + NODE_ID, 2, (const uint8_t[]){0x55, 0x66});
+	co_sim_rx(0x200 + NODE_ID, 2, (const uint8_t[]){0x55, 0x66});
 	zassert_equal(get_u8(0x2000, 1), 0, "a short RPDO is not processed");
 	zassert_equal(count(EMCY_ID), 1);
 	zassert_equal(emcy_code(0), 0x8210);
-	rx(0x200 + NODE_ID, 2, (const uint8_t[]){0x55, 0x66});
+	co_sim_rx(0x200 + NODE_ID, 2, (const uint8_t[]){0x55, 0x66});
 	zassert_equal(count(EMCY_ID), 1, "raised once while it lasts");
 
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x55, 0x66, 0x77});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x55, 0x66, 0x77});
 	zassert_equal(get_u8(0x2000, 1), 0x55);
 	zassert_equal(count(EMCY_ID), 2);
 	zassert_equal(emcy_code(1), 0x0000, "the right length clears it");
 
-	rx(0x200 + NODE_ID, 8, (const uint8_t[]){0x56, 0x66, 0x77, 1, 2, 3, 4, 5});
+	co_sim_rx(0x200 + NODE_ID, 8, (const uint8_t[]){0x56, 0x66, 0x77, 1, 2, 3, 4, 5});
 	zassert_equal(get_u8(0x2000, 1), 0x56, "a long RPDO is processed");
 	zassert_equal(count(EMCY_ID), 3);
 	zassert_equal(emcy_code(2), 0x8220);
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x57, 0x66, 0x77});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x57, 0x66, 0x77});
 	zassert_equal(count(EMCY_ID), 4);
 	zassert_equal(emcy_code(3), 0x0000);
 }
 
 ZTEST(co_pdo, test_rpdo_timeout_emcy_8250h_and_clear)
 {
-	zassert_equal(wr(0x1400, 5, 100, 2), 0U, "event timer 100 ms");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 5, 100, 2), 0U, "event timer 100 ms");
 	go_operational();
-	run_until(500 * MS);
+	co_sim_run_until(500 * MS);
 	zassert_equal(count(EMCY_ID), 0, "the monitor arms at the first RPDO");
 
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
-	run_until(599 * MS);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
+	co_sim_run_until(599 * MS);
 	zassert_equal(count(EMCY_ID), 0);
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
-	run_until(698 * MS);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
+	co_sim_run_until(698 * MS);
 	zassert_equal(count(EMCY_ID), 0, "restarted by every RPDO");
-	run_until(699 * MS);
+	co_sim_run_until(699 * MS);
 	zassert_equal(count(EMCY_ID), 1);
 	zassert_equal(emcy_code(0), 0x8250);
-	run_until(2000 * MS);
+	co_sim_run_until(2000 * MS);
 	zassert_equal(count(EMCY_ID), 1, "raised once");
 
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){1, 2, 3});
 	zassert_equal(count(EMCY_ID), 2);
 	zassert_equal(emcy_code(1), 0x0000, "cleared by the next RPDO");
 }
@@ -319,7 +261,7 @@ ZTEST(co_pdo, test_rpdo_dummy_mapping)
 
 	setup_pdo(true, 1, 0x321, 255, map, 4);
 	go_operational();
-	rx(0x321, 5, (const uint8_t[]){0xAA, 0x11, 0xBB, 0xCC, 0x22});
+	co_sim_rx(0x321, 5, (const uint8_t[]){0xAA, 0x11, 0xBB, 0xCC, 0x22});
 	zassert_equal(get_u8(0x2000, 2), 0x11);
 	zassert_equal(get_u8(0x2000, 3), 0x22);
 	zassert_equal(t.rpdo_ind_num, 1);
@@ -328,15 +270,18 @@ ZTEST(co_pdo, test_rpdo_dummy_mapping)
 
 ZTEST(co_pdo, test_rpdo_dummy_entry_rules)
 {
-	zassert_equal(wr(0x1401, 1, INVALID | 0x321, 4), 0U);
-	zassert_equal(wr(0x1601, 1, 0x00050010, 4), CO_SDO_AB_NO_MAP, "U8 dummy of 16 bits");
-	zassert_equal(wr(0x1601, 1, 0x00050108, 4), CO_SDO_AB_NO_MAP, "dummy with a sub-index");
+	zassert_equal(co_sim_write(&t.node, 0x1401, 1, INVALID | 0x321, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x00050010, 4), CO_SDO_AB_NO_MAP,
+		      "U8 dummy of 16 bits");
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x00050108, 4), CO_SDO_AB_NO_MAP,
+		      "dummy with a sub-index");
 #if !defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	zassert_equal(wr(0x1601, 1, 0x00010001, 4), CO_SDO_AB_NO_MAP,
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x00010001, 4), CO_SDO_AB_NO_MAP,
 		      "BOOLEAN dummy (1 bit) needs bit-wise mapping");
 #endif
-	zassert_equal(wr(0x1801, 1, INVALID | 0x2A1, 4), 0U);
-	zassert_equal(wr(0x1A01, 1, 0x00050008, 4), CO_SDO_AB_NO_MAP, "no dummy in a TPDO");
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, INVALID | 0x2A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1A01, 1, 0x00050008, 4), CO_SDO_AB_NO_MAP,
+		      "no dummy in a TPDO");
 }
 
 ZTEST(co_pdo, test_sync_rpdo_committed_at_next_sync)
@@ -345,7 +290,7 @@ ZTEST(co_pdo, test_sync_rpdo_committed_at_next_sync)
 
 	setup_pdo(true, 0, 0x200 + NODE_ID, 1, map, 1);
 	go_operational();
-	rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x42});
+	co_sim_rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x42});
 	zassert_equal(get_u8(0x2000, 1), 0, "held until SYNC");
 	zassert_equal(t.n_rpdo_ind, 0);
 	sync_rx();
@@ -362,17 +307,17 @@ ZTEST(co_pdo, test_sync_window_discards_late_rpdo)
 	const uint32_t map[] = {0x20000108};
 
 	setup_pdo(true, 0, 0x200 + NODE_ID, 0, map, 1);
-	zassert_equal(wr(0x1007, 0, 5000, 4), 0U, "window 5 ms");
+	zassert_equal(co_sim_write(&t.node, 0x1007, 0, 5000, 4), 0U, "window 5 ms");
 	go_operational();
 	sync_rx();
-	run_until(3 * MS);
-	rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x10});
-	run_until(10 * MS);
+	co_sim_run_until(3 * MS);
+	co_sim_rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x10});
+	co_sim_run_until(10 * MS);
 	sync_rx();
 	zassert_equal(get_u8(0x2000, 1), 0x10, "inside the window: committed");
-	run_until(16 * MS);
-	rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x20});
-	run_until(20 * MS);
+	co_sim_run_until(16 * MS);
+	co_sim_rx(0x200 + NODE_ID, 1, (const uint8_t[]){0x20});
+	co_sim_run_until(20 * MS);
 	sync_rx();
 	zassert_equal(get_u8(0x2000, 1), 0x10, "after the window: discarded");
 	zassert_equal(t.n_rpdo_ind, 1);
@@ -385,17 +330,17 @@ ZTEST(co_pdo, test_tpdo_request_packs_mapped_objects)
 	zassert_equal(co_tpdo_send_req(&t.node, 0), -ENETDOWN, "not in Pre-operational");
 	go_operational();
 	app_u8(0x2000, 5, 0xAB);
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	app_u32(0x2002, 0, 0x12345678);
 	zassert_equal(count(0x180 + NODE_ID), 1, "change of state of a mapped object");
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	zassert_ok(co_tpdo_send_req(&t.node, 0));
-	zassert_equal(t.n_sent, 1);
-	zassert_equal(t.sent[0].id, 0x180 + NODE_ID);
-	zassert_equal(t.sent[0].dlc, 5);
+	zassert_equal(sim.n_sent, 1);
+	zassert_equal(sim.sent[0].id, 0x180 + NODE_ID);
+	zassert_equal(sim.sent[0].dlc, 5);
 	const uint8_t want[5] = {0xAB, 0x78, 0x56, 0x34, 0x12};
 
-	zassert_mem_equal(t.sent[0].data, want, 5);
+	zassert_mem_equal(sim.sent[0].data, want, 5);
 	zassert_true(t.n_tpdo_ind > 0, "the application is asked to refresh the data");
 	zassert_equal(co_tpdo_send_req(&t.node, 1), -EINVAL, "TPDO 1 is not valid");
 	zassert_equal(co_tpdo_send_req(&t.node, 9), -EINVAL);
@@ -405,14 +350,14 @@ ZTEST(co_pdo, test_tpdo_change_of_state_only_for_mapped_objects_and_event_types)
 {
 	go_operational();
 	app_u8(0x2000, 6, 1);
-	zassert_equal(t.n_sent, 0, "2000h:06 is not mapped");
-	zassert_equal(wr(0x2000, 5, 7, 1), 0U);
-	zassert_equal(t.n_sent, 1, "an SDO write is a change of state too");
-	zassert_equal(t.sent[0].data[0], 7);
+	zassert_equal(sim.n_sent, 0, "2000h:06 is not mapped");
+	zassert_equal(co_sim_write(&t.node, 0x2000, 5, 7, 1), 0U);
+	zassert_equal(sim.n_sent, 1, "an SDO write is a change of state too");
+	zassert_equal(sim.sent[0].data[0], 7);
 
 	const uint32_t map[] = {0x20000608};
 
-	nmt(0x80);
+	co_sim_nmt(0x80, NODE_ID);
 	setup_pdo(false, 1, 0x2A1, 1, map, 1);
 	go_operational();
 	app_u8(0x2000, 6, 2);
@@ -425,78 +370,81 @@ ZTEST(co_pdo, test_rpdo_write_is_change_of_state_of_a_tpdo_mapped_later)
 	const uint32_t map[] = {0x20000108};
 
 	go_operational();
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x11, 0, 0});
-	zassert_equal(t.n_sent, 0, "2000h:01 is in no TPDO yet");
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x11, 0, 0});
+	zassert_equal(sim.n_sent, 0, "2000h:01 is in no TPDO yet");
 
-	nmt(0x80);
+	co_sim_nmt(0x80, NODE_ID);
 	setup_pdo(false, 1, 0x2A1, 254, map, 1);
 	go_operational();
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x22, 0, 0});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x22, 0, 0});
 	zassert_equal(count(0x2A1), 1, "the RPDO write is a change of state of TPDO 1");
 	zassert_equal(nth(0x2A1, 0)->data[0], 0x22);
 
-	nmt(0x80);
-	zassert_equal(wr(0x1801, 1, INVALID | 0x2A1, 4), 0U);
-	zassert_equal(wr(0x1A01, 0, 0, 1), 0U, "unmapped: its hook goes");
-	zassert_equal(wr(0x1801, 1, 0x2A1, 4), 0U);
+	co_sim_nmt(0x80, NODE_ID);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, INVALID | 0x2A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1A01, 0, 0, 1), 0U, "unmapped: its hook goes");
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, 0x2A1, 4), 0U);
 	go_operational();
-	rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x33, 0, 0});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x33, 0, 0});
 	zassert_equal(count(0x2A1), 0);
 	zassert_equal(get_u8(0x2000, 1), 0x33);
 }
 
 ZTEST(co_pdo, test_tpdo_inhibit_defers_and_merges)
 {
-	zassert_equal(wr(0x1800, 3, 100, 2), CO_SDO_AB_INVALID_VALUE, "inhibit while valid");
-	zassert_equal(wr(0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U);
-	zassert_equal(wr(0x1800, 3, 100, 2), 0U, "10 ms");
-	zassert_equal(wr(0x1800, 1, 0x180 + NODE_ID, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 3, 100, 2), CO_SDO_AB_INVALID_VALUE,
+		      "inhibit while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 3, 100, 2), 0U, "10 ms");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, 0x180 + NODE_ID, 4), 0U);
 	go_operational();
-	run_until(1 * MS);
+	co_sim_run_until(1 * MS);
 	zassert_ok(co_tpdo_send_req(&t.node, 0));
-	zassert_equal(t.n_sent, 1);
-	run_until(3 * MS);
+	zassert_equal(sim.n_sent, 1);
+	co_sim_run_until(3 * MS);
 	app_u8(0x2000, 5, 1);
 	zassert_ok(co_tpdo_send_req(&t.node, 0), "no error while inhibited");
-	run_until(5 * MS);
+	co_sim_run_until(5 * MS);
 	app_u8(0x2000, 5, 2);
-	zassert_equal(t.n_sent, 1, "held back by the inhibit time");
-	run_until(10 * MS);
-	zassert_equal(t.n_sent, 1);
-	run_until(11 * MS);
-	zassert_equal(t.n_sent, 2, "one frame when the inhibit time ends");
-	zassert_equal(t.sent_at[1], 11 * MS);
-	zassert_equal(t.sent[1].data[0], 2, "with the latest data");
-	run_until(100 * MS);
-	zassert_equal(t.n_sent, 2, "requests were merged");
+	zassert_equal(sim.n_sent, 1, "held back by the inhibit time");
+	co_sim_run_until(10 * MS);
+	zassert_equal(sim.n_sent, 1);
+	co_sim_run_until(11 * MS);
+	zassert_equal(sim.n_sent, 2, "one frame when the inhibit time ends");
+	zassert_equal(sim.sent_at[1], 11 * MS);
+	zassert_equal(sim.sent[1].data[0], 2, "with the latest data");
+	co_sim_run_until(100 * MS);
+	zassert_equal(sim.n_sent, 2, "requests were merged");
 	for (int i = 0; i < 20; i++) {
 		app_u8(0x2000, 5, (uint8_t)i);
-		run_until(t.now + 300);
+		co_sim_run_until(sim.now + 300);
 	}
-	for (int i = 1; i < t.n_sent; i++) {
-		zassert_true(t.sent_at[i] - t.sent_at[i - 1] >= 10 * MS, "frames %d, %d", i - 1, i);
+	for (int i = 1; i < sim.n_sent; i++) {
+		zassert_true(sim.sent_at[i] - sim.sent_at[i - 1] >= 10 * MS, "frames %d, %d", i - 1,
+			     i);
 	}
 }
 
 ZTEST(co_pdo, test_tpdo_event_timer)
 {
-	zassert_equal(wr(0x1800, 2, 254, 1), 0U);
-	zassert_equal(wr(0x1800, 5, 100, 2), 0U, "event timer may change while valid");
-	run_until(500 * MS);
-	zassert_equal(t.n_sent, 0, "not in Pre-operational");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 254, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 5, 100, 2), 0U,
+		      "event timer may change while valid");
+	co_sim_run_until(500 * MS);
+	zassert_equal(sim.n_sent, 0, "not in Pre-operational");
 	go_operational();
-	run_until(850 * MS);
+	co_sim_run_until(850 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 3);
 	zassert_equal(nth_at(0x180 + NODE_ID, 0), 600 * MS);
 	zassert_equal(nth_at(0x180 + NODE_ID, 2), 800 * MS);
 	app_u8(0x2000, 5, 9);
 	zassert_equal(count(0x180 + NODE_ID), 4, "event at 850 ms");
-	run_until(949 * MS);
+	co_sim_run_until(949 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 4, "the event timer restarts at each frame");
-	run_until(950 * MS);
+	co_sim_run_until(950 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 5);
-	nmt(0x80);
-	run_until(2000 * MS);
+	co_sim_nmt(0x80, NODE_ID);
+	co_sim_run_until(2000 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 5, "stops outside Operational");
 }
 
@@ -546,12 +494,13 @@ ZTEST(co_pdo, test_tpdo_sync_start_value)
 
 	setup_pdo(false, 1, 0x2A1, 2, map, 1);
 	setup_pdo(false, 2, 0x3A1, 2, map, 1);
-	zassert_equal(wr(0x1802, 6, 3, 1), CO_SDO_AB_INVALID_VALUE, "not while valid");
-	zassert_equal(wr(0x1802, 1, INVALID | 0x3A1, 4), 0U);
-	zassert_equal(wr(0x1802, 6, 241, 1), CO_SDO_AB_INVALID_VALUE, "1..240");
-	zassert_equal(wr(0x1802, 6, 3, 1), 0U);
-	zassert_equal(wr(0x1802, 1, 0x3A1, 4), 0U);
-	zassert_equal(wr(0x1019, 0, 5, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1802, 6, 3, 1), CO_SDO_AB_INVALID_VALUE,
+		      "not while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1802, 1, INVALID | 0x3A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1802, 6, 241, 1), CO_SDO_AB_INVALID_VALUE, "1..240");
+	zassert_equal(co_sim_write(&t.node, 0x1802, 6, 3, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1802, 1, 0x3A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1019, 0, 5, 1), 0U);
 	go_operational();
 	/* Counters 1 2 3 4 5 1 2 3 4. */
 	int sent_start[9];
@@ -582,26 +531,26 @@ ZTEST(co_pdo, test_sync_window_drops_late_tpdo)
 	const uint32_t map[] = {0x20000108};
 
 	setup_pdo(false, 1, INVALID | 0x2A1, 1, map, 1);
-	zassert_equal(wr(0x1801, 3, 80, 2), 0U, "inhibit 8 ms");
-	zassert_equal(wr(0x1801, 1, 0x2A1, 4), 0U);
-	zassert_equal(wr(0x1007, 0, 5000, 4), 0U, "window 5 ms");
+	zassert_equal(co_sim_write(&t.node, 0x1801, 3, 80, 2), 0U, "inhibit 8 ms");
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, 0x2A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1007, 0, 5000, 4), 0U, "window 5 ms");
 	go_operational();
 	sync_rx();
 	zassert_equal(count(0x2A1), 1);
-	run_until(1 * MS);
+	co_sim_run_until(1 * MS);
 	sync_rx();
-	run_until(9 * MS);
+	co_sim_run_until(9 * MS);
 	zassert_equal(count(0x2A1), 1, "inhibited until 8 ms, window closed at 6 ms: dropped");
 
-	zassert_equal(wr(0x1007, 0, 0, 4), 0U, "no window");
-	run_until(10 * MS);
+	zassert_equal(co_sim_write(&t.node, 0x1007, 0, 0, 4), 0U, "no window");
+	co_sim_run_until(10 * MS);
 	sync_rx();
 	zassert_equal(count(0x2A1), 2);
-	run_until(11 * MS);
+	co_sim_run_until(11 * MS);
 	sync_rx();
-	run_until(17 * MS);
+	co_sim_run_until(17 * MS);
 	zassert_equal(count(0x2A1), 2);
-	run_until(18 * MS);
+	co_sim_run_until(18 * MS);
 	zassert_equal(count(0x2A1), 3, "without a window the sample goes out late");
 	zassert_equal(nth_at(0x2A1, 2), 18 * MS);
 }
@@ -614,7 +563,7 @@ ZTEST(co_pdo, test_tpdo_rtr)
 	setup_pdo(false, 2, 0x3A1, 252, map, 1);
 	go_operational();
 	app_u8(0x2000, 1, 0x31);
-	zassert_equal(t.n_sent, 0, "RTR-only TPDOs ignore changes of state");
+	zassert_equal(sim.n_sent, 0, "RTR-only TPDOs ignore changes of state");
 	rx_rtr(0x2A1, 1);
 	zassert_equal(count(0x2A1), 1, "253: sampled and sent on RTR");
 	zassert_equal(nth(0x2A1, 0)->data[0], 0x31);
@@ -628,43 +577,43 @@ ZTEST(co_pdo, test_tpdo_rtr)
 	zassert_equal(count(0x3A1), 1);
 	zassert_equal(nth(0x3A1, 0)->data[0], 0x31, "252: the sample of the SYNC");
 
-	rx(0x2A1, 1, (const uint8_t[]){0});
+	co_sim_rx(0x2A1, 1, (const uint8_t[]){0});
 	zassert_equal(count(0x2A1), 1, "a data frame is not a request");
 
 	/* Bit 30 = 1: no RTR; refused for the RTR-only types. */
-	zassert_equal(wr(0x1801, 1, 0x2A1 | NO_RTR, 4), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, 0x2A1 | NO_RTR, 4), CO_SDO_AB_INVALID_VALUE,
 		      "bit 30 may not change while valid");
-	nmt(0x80);
-	zassert_equal(wr(0x1801, 1, INVALID | NO_RTR | 0x2A1, 4), CO_SDO_AB_INVALID_VALUE,
-		      "253 needs RTR");
-	zassert_equal(wr(0x1801, 2, 255, 1), 0U);
-	zassert_equal(wr(0x1801, 1, INVALID | NO_RTR | 0x2A1, 4), 0U);
-	zassert_equal(wr(0x1801, 2, 253, 1), CO_SDO_AB_INVALID_VALUE);
-	zassert_equal(wr(0x1801, 1, NO_RTR | 0x2A1, 4), 0U);
+	co_sim_nmt(0x80, NODE_ID);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, INVALID | NO_RTR | 0x2A1, 4),
+		      CO_SDO_AB_INVALID_VALUE, "253 needs RTR");
+	zassert_equal(co_sim_write(&t.node, 0x1801, 2, 255, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, INVALID | NO_RTR | 0x2A1, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 2, 253, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 1, NO_RTR | 0x2A1, 4), 0U);
 	go_operational();
 	rx_rtr(0x2A1, 1);
-	zassert_equal(t.n_sent, 0, "RTR not allowed");
-	zassert_equal(wr(0x1800, 2, 255, 1), 0U);
+	zassert_equal(sim.n_sent, 0, "RTR not allowed");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 255, 1), 0U);
 	rx_rtr(0x180 + NODE_ID, 0);
 	zassert_equal(count(0x180 + NODE_ID), 1, "an RTR is an event for 254/255");
 }
 
 ZTEST(co_pdo, test_nmt_gating)
 {
-	zassert_equal(wr(0x1800, 2, 254, 1), 0U);
-	zassert_equal(wr(0x1800, 5, 10, 2), 0U);
-	run_until(100 * MS);
-	zassert_equal(t.n_sent, 0, "Pre-operational");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 254, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 5, 10, 2), 0U);
+	co_sim_run_until(100 * MS);
+	zassert_equal(sim.n_sent, 0, "Pre-operational");
 	go_operational();
-	run_until(200 * MS);
+	co_sim_run_until(200 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 10);
-	nmt(0x02);
-	t.n_sent = 0;
-	run_until(300 * MS);
-	zassert_equal(t.n_sent, 0, "Stopped");
+	co_sim_nmt(0x02, NODE_ID);
+	sim.n_sent = 0;
+	co_sim_run_until(300 * MS);
+	zassert_equal(sim.n_sent, 0, "Stopped");
 	zassert_equal(co_tpdo_send_req(&t.node, 0), -ENETDOWN);
-	nmt(0x01);
-	run_until(400 * MS);
+	co_sim_nmt(0x01, NODE_ID);
+	co_sim_run_until(400 * MS);
 	zassert_equal(count(0x180 + NODE_ID), 10, "Operational again");
 }
 
@@ -676,9 +625,9 @@ ZTEST(co_pdo, test_29_bit_pdos)
 	setup_pdo(true, 1, 0x20012345, 255, map, 1);
 	setup_pdo(false, 1, 0x20054321, 254, map, 1);
 	go_operational();
-	rx(0x12345, 1, (const uint8_t[]){0x66});
+	co_sim_rx(0x12345, 1, (const uint8_t[]){0x66});
 	zassert_equal(get_u8(0x2000, 1), 0, "an 11-bit frame is another CAN-ID");
-	co_line_rx(&t.line, &f, t.now);
+	co_line_rx(&sim.line, &f, sim.now);
 	zassert_equal(get_u8(0x2000, 1), 0x77);
 	zassert_equal(count(0x54321), 1, "the change of state goes out on the 29-bit id");
 	zassert_true((nth(0x54321, 0)->flags & CAN_FRAME_IDE) != 0U);
@@ -688,20 +637,26 @@ ZTEST(co_pdo, test_29_bit_pdos)
 
 ZTEST(co_pdo, test_comm_param_abort_codes)
 {
-	zassert_equal(wr(0x1400, 1, 0x301 + NODE_ID, 4), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, 0x301 + NODE_ID, 4), CO_SDO_AB_INVALID_VALUE,
 		      "CAN-ID change while valid");
-	zassert_equal(wr(0x1400, 1, INVALID | (0x200 + NODE_ID), 4), 0U, "bit 31 may change");
-	zassert_equal(wr(0x1400, 1, INVALID | 0x305, 4), 0U, "then the CAN-ID");
-	zassert_equal(wr(0x1400, 1, 0x701, 4), CO_SDO_AB_INVALID_VALUE, "restricted CAN-ID");
-	zassert_equal(wr(0x1400, 1, 0x0000FFFF, 4), CO_SDO_AB_INVALID_VALUE, "not 11-bit");
-	zassert_equal(wr(0x1400, 2, 241, 1), CO_SDO_AB_INVALID_VALUE);
-	zassert_equal(wr(0x1400, 2, 252, 1), CO_SDO_AB_INVALID_VALUE, "RTR types are TPDO only");
-	zassert_equal(wr(0x1400, 2, 254, 1), 0U);
-	zassert_equal(wr(0x1800, 2, 245, 1), CO_SDO_AB_INVALID_VALUE);
-	zassert_equal(wr(0x1800, 2, 251, 1), CO_SDO_AB_INVALID_VALUE);
-	zassert_equal(wr(0x1800, 2, 240, 1), 0U, "type may change while valid");
-	zassert_equal(wr(0x1800, 3, 1, 2), CO_SDO_AB_INVALID_VALUE, "inhibit while valid");
-	zassert_equal(wr(0x1800, 6, 1, 1), CO_SDO_AB_INVALID_VALUE, "start value while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, INVALID | (0x200 + NODE_ID), 4), 0U,
+		      "bit 31 may change");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, INVALID | 0x305, 4), 0U, "then the CAN-ID");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, 0x701, 4), CO_SDO_AB_INVALID_VALUE,
+		      "restricted CAN-ID");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, 0x0000FFFF, 4), CO_SDO_AB_INVALID_VALUE,
+		      "not 11-bit");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 241, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 252, 1), CO_SDO_AB_INVALID_VALUE,
+		      "RTR types are TPDO only");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 254, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 245, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 251, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 240, 1), 0U, "type may change while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 3, 1, 2), CO_SDO_AB_INVALID_VALUE,
+		      "inhibit while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 6, 1, 1), CO_SDO_AB_INVALID_VALUE,
+		      "start value while valid");
 }
 
 /* --- Mapping procedure ------------------------------------------------------------------ */
@@ -710,68 +665,88 @@ ZTEST(co_pdo, test_mapping_procedure_abort_codes)
 {
 	uint8_t n = 0xEE;
 
-	zassert_equal(wr(0x1A00, 0, 0, 1), CO_SDO_AB_INVALID_VALUE, "sub 0 while valid");
-	zassert_equal(wr(0x1A00, 1, 0x20000108, 4), CO_SDO_AB_INVALID_VALUE, "entry while valid");
-	zassert_equal(wr(0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U, "step 1");
-	zassert_equal(wr(0x1A00, 1, 0x20000108, 4), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0, 1), CO_SDO_AB_INVALID_VALUE,
+		      "sub 0 while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20000108, 4), CO_SDO_AB_INVALID_VALUE,
+		      "entry while valid");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U,
+		      "step 1");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20000108, 4), CO_SDO_AB_INVALID_VALUE,
 		      "entry while sub 0 != 0");
-	zassert_equal(wr(0x1A00, 0, 0, 1), 0U, "step 2");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0, 1), 0U, "step 2");
 
 	/* Step 3: entries are checked as they are written. */
-	zassert_equal(wr(0x1A00, 1, 0x30000008, 4), CO_SDO_AB_NO_OBJECT, "missing object");
-	zassert_equal(wr(0x1A00, 1, 0x20000908, 4), CO_SDO_AB_NO_SUB, "missing sub-index");
-	zassert_equal(wr(0x1A00, 1, 0x20030020, 4), CO_SDO_AB_NO_MAP, "PDOMapping=0");
-	zassert_equal(wr(0x1A00, 1, 0x10000020, 4), CO_SDO_AB_NO_MAP, "1000h");
-	zassert_equal(wr(0x1A00, 1, 0x20080008, 4), CO_SDO_AB_NO_MAP, "rww into a TPDO");
-	zassert_equal(wr(0x1A00, 1, 0x20020028, 4), CO_SDO_AB_NO_MAP, "40 bits of a U32");
-	zassert_equal(wr(0x1A00, 1, 0x20000100, 4), CO_SDO_AB_NO_MAP, "length 0");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x30000008, 4), CO_SDO_AB_NO_OBJECT,
+		      "missing object");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20000908, 4), CO_SDO_AB_NO_SUB,
+		      "missing sub-index");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20030020, 4), CO_SDO_AB_NO_MAP,
+		      "PDOMapping=0");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x10000020, 4), CO_SDO_AB_NO_MAP, "1000h");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20080008, 4), CO_SDO_AB_NO_MAP,
+		      "rww into a TPDO");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20020028, 4), CO_SDO_AB_NO_MAP,
+		      "40 bits of a U32");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20000100, 4), CO_SDO_AB_NO_MAP,
+		      "length 0");
 #if !defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	zassert_equal(wr(0x1A00, 1, 0x20020010, 4), CO_SDO_AB_NO_MAP, "part of an object");
-	zassert_equal(wr(0x1A00, 1, 0x20000104, 4), CO_SDO_AB_NO_MAP, "not whole bytes");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20020010, 4), CO_SDO_AB_NO_MAP,
+		      "part of an object");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 1, 0x20000104, 4), CO_SDO_AB_NO_MAP,
+		      "not whole bytes");
 #endif
-	zassert_equal(wr(0x1400, 1, INVALID | (0x200 + NODE_ID), 4), 0U);
-	zassert_equal(wr(0x1600, 0, 0, 1), 0U);
-	zassert_equal(wr(0x1600, 1, 0x20040008, 4), CO_SDO_AB_NO_MAP, "ro into an RPDO");
-	zassert_equal(wr(0x1600, 1, 0x20080008, 4), 0U, "rww into an RPDO");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, INVALID | (0x200 + NODE_ID), 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1600, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1600, 1, 0x20040008, 4), CO_SDO_AB_NO_MAP,
+		      "ro into an RPDO");
+	zassert_equal(co_sim_write(&t.node, 0x1600, 1, 0x20080008, 4), 0U, "rww into an RPDO");
 
 	/* Step 4: the whole mapping is checked when sub 0 is written. */
 	for (uint8_t i = 1; i <= 3; i++) {
-		zassert_equal(wr(0x1A00, i, 0x20020020, 4), 0U);
+		zassert_equal(co_sim_write(&t.node, 0x1A00, i, 0x20020020, 4), 0U);
 	}
-	zassert_equal(wr(0x1A00, 0, 3, 1), CO_SDO_AB_MAP_LEN, "96 bits");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 3, 1), CO_SDO_AB_MAP_LEN, "96 bits");
 	for (uint8_t i = 1; i <= 9; i++) {
-		zassert_equal(wr(0x1A00, i, 0x20000008 | (uint32_t)(i <= 8 ? i : 1) << 8, 4), 0U);
+		zassert_equal(co_sim_write(&t.node, 0x1A00, i,
+					   0x20000008 | (uint32_t)(i <= 8 ? i : 1) << 8, 4),
+			      0U);
 	}
-	zassert_equal(wr(0x1A00, 0, 9, 1), CO_SDO_AB_MAP_LEN, "9 x 8 bits");
-	zassert_equal(wr(0x1A00, 0, 65, 1), CO_SDO_AB_MAP_LEN, "more than 64 entries");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 9, 1), CO_SDO_AB_MAP_LEN, "9 x 8 bits");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 65, 1), CO_SDO_AB_MAP_LEN,
+		      "more than 64 entries");
 #if defined(CONFIG_CANOPEN_MPDO)
-	zassert_equal(wr(0x1A00, 0, 0xFE, 1), 0U, "SAM-MPDO on a type 255 TPDO (src/mpdo.c)");
-	zassert_equal(wr(0x1A00, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0xFE, 1), 0U,
+		      "SAM-MPDO on a type 255 TPDO (src/mpdo.c)");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0, 1), 0U);
 #else
-	zassert_equal(wr(0x1A00, 0, 0xFE, 1), CO_SDO_AB_INVALID_VALUE, "MPDO not built in");
-	zassert_equal(wr(0x1A00, 0, 0xFF, 1), CO_SDO_AB_INVALID_VALUE, "MPDO not built in");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0xFE, 1), CO_SDO_AB_INVALID_VALUE,
+		      "MPDO not built in");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0xFF, 1), CO_SDO_AB_INVALID_VALUE,
+		      "MPDO not built in");
 #endif
-	zassert_equal(wr(0x1A00, 0, 8, 1), 0U, "8 x 8 bits");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 8, 1), 0U, "8 x 8 bits");
 	zassert_ok(co_od_get_u8(co_node_od(&t.node), 0x1A00, 0, &n));
 	zassert_equal(n, 8);
-	zassert_equal(wr(0x1800, 1, 0x180 + NODE_ID, 4), 0U, "step 5");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, 0x180 + NODE_ID, 4), 0U, "step 5");
 
 	go_operational();
 	for (uint8_t i = 1; i <= 8; i++) {
 		app_u8(0x2000, i, (uint8_t)(0x10 + i));
 	}
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	zassert_ok(co_tpdo_send_req(&t.node, 0));
-	zassert_equal(t.n_sent, 1);
-	zassert_equal(t.sent[0].dlc, 8);
-	zassert_equal(t.sent[0].data[0], 0x11);
-	zassert_equal(t.sent[0].data[7], 0x18);
+	zassert_equal(sim.n_sent, 1);
+	zassert_equal(sim.sent[0].dlc, 8);
+	zassert_equal(sim.sent[0].data[0], 0x11);
+	zassert_equal(sim.sent[0].data[7], 0x18);
 
-	zassert_equal(wr(0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, INVALID | (0x180 + NODE_ID), 4), 0U);
 #if defined(CONFIG_CANOPEN_PDO_REMAP_IN_OPERATIONAL)
-	zassert_equal(wr(0x1A00, 0, 0, 1), 0U, "remapping allowed in Operational");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0, 1), 0U,
+		      "remapping allowed in Operational");
 #else
-	zassert_equal(wr(0x1A00, 0, 0, 1), CO_SDO_AB_DATA_DEV_STATE, "no remapping in Operational");
+	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 0, 1), CO_SDO_AB_DATA_DEV_STATE,
+		      "no remapping in Operational");
 #endif
 }
 
@@ -780,7 +755,7 @@ ZTEST(co_pdo, test_reset_communication_restores_mapping)
 	const uint32_t map[] = {0x20000108};
 
 	setup_pdo(false, 0, 0x2A1, 254, map, 1);
-	nmt(0x82);
+	co_sim_nmt(0x82, NODE_ID);
 	go_operational();
 	app_u32(0x2002, 0, 0x01020304);
 	zassert_equal(count(0x180 + NODE_ID), 1, "the default TPDO 0 is back");
@@ -790,11 +765,14 @@ ZTEST(co_pdo, test_reset_communication_restores_mapping)
 #if !defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 ZTEST(co_pdo, test_bitwise_mapping)
 {
-	zassert_equal(wr(0x1401, 1, INVALID | 0x321, 4), 0U);
-	zassert_equal(wr(0x1601, 0, 0, 1), 0U);
-	zassert_equal(wr(0x1601, 1, 0x20050101, 4), CO_SDO_AB_NO_MAP, "1 bit of a BOOLEAN");
-	zassert_equal(wr(0x1601, 1, 0x2006000C, 4), CO_SDO_AB_NO_MAP, "12 bits of an INTEGER16");
-	zassert_equal(wr(0x1601, 1, 0x20050108, 4), 0U, "a BOOLEAN as a whole byte");
+	zassert_equal(co_sim_write(&t.node, 0x1401, 1, INVALID | 0x321, 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1601, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x20050101, 4), CO_SDO_AB_NO_MAP,
+		      "1 bit of a BOOLEAN");
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x2006000C, 4), CO_SDO_AB_NO_MAP,
+		      "12 bits of an INTEGER16");
+	zassert_equal(co_sim_write(&t.node, 0x1601, 1, 0x20050108, 4), 0U,
+		      "a BOOLEAN as a whole byte");
 }
 #else
 ZTEST(co_pdo, test_bitwise_mapping)
@@ -813,7 +791,7 @@ ZTEST(co_pdo, test_bitwise_mapping)
 	setup_pdo(true, 1, 0x321, 255, rmap, 5);
 	setup_pdo(false, 1, 0x2A1, 254, tmap, 4);
 	go_operational();
-	rx(0x321, 3, d);
+	co_sim_rx(0x321, 3, d);
 	zassert_ok(co_od_get_bool(co_node_od(&t.node), 0x2005, 1, &b));
 	zassert_true(b);
 	zassert_ok(co_od_get_bool(co_node_od(&t.node), 0x2005, 2, &b));
@@ -827,13 +805,13 @@ ZTEST(co_pdo, test_bitwise_mapping)
 	zassert_ok(co_od_set_u16(co_node_od(&t.node), 0x2001, 0, 0x7FF, CO_OD_WRITER_APP));
 	zassert_ok(co_od_set_u8(co_node_od(&t.node), 0x2000, 1, 0xA5, CO_OD_WRITER_APP));
 	co_node_unlock(&t.node);
-	t.n_sent = 0;
+	sim.n_sent = 0;
 	zassert_ok(co_tpdo_send_req(&t.node, 1));
-	zassert_equal(t.n_sent, 1);
+	zassert_equal(sim.n_sent, 1);
 	v = 1U | (0U << 1) | (0x3FFU << 2) | (0xA5U << 12);
-	zassert_equal(t.sent[0].dlc, 3);
-	zassert_equal(t.sent[0].data[0], (uint8_t)v);
-	zassert_equal(t.sent[0].data[1], (uint8_t)(v >> 8));
-	zassert_equal(t.sent[0].data[2], (uint8_t)(v >> 16), "bit 10 of 2001h is not mapped");
+	zassert_equal(sim.sent[0].dlc, 3);
+	zassert_equal(sim.sent[0].data[0], (uint8_t)v);
+	zassert_equal(sim.sent[0].data[1], (uint8_t)(v >> 8));
+	zassert_equal(sim.sent[0].data[2], (uint8_t)(v >> 16), "bit 10 of 2001h is not mapped");
 }
 #endif

@@ -22,6 +22,7 @@
 #include <canopen/pdo.h>
 #include <canopen/sdo_abort.h>
 
+#include "co_sim.h"
 #include "pdo_test_od.h"
 
 #if defined(CONFIG_CANOPEN_MPDO)
@@ -37,39 +38,14 @@
 #define MS      1000ULL
 
 static struct {
-	struct co_line line;
 	struct co_node node;
 	struct pdo_test_od_ram ram;
-	struct can_frame sent[MAX_TX];
-	int n_sent;
 	int n_rpdo_ind;
-	uint64_t now;
 } m;
-
-static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
-{
-	zassert_true(m.n_sent < MAX_TX, "too many frames");
-	m.sent[m.n_sent++] = *frame;
-	return 0;
-}
 
 static void rpdo_ind(struct co_node *node, uint16_t num, void *user_data)
 {
 	m.n_rpdo_ind++;
-}
-
-static uint32_t wr(uint16_t index, uint8_t sub, uint64_t value, size_t len)
-{
-	uint8_t buf[8];
-	uint32_t ab;
-
-	for (size_t i = 0; i < len; i++) {
-		buf[i] = (uint8_t)(value >> (8 * i));
-	}
-	co_node_lock(&m.node);
-	ab = co_od_write(co_node_od(&m.node), index, sub, buf, len, CO_OD_WRITER_SDO);
-	co_node_unlock(&m.node);
-	return ab;
 }
 
 static uint8_t get_u8(uint16_t index, uint8_t sub)
@@ -93,39 +69,24 @@ static void rx8(uint32_t id, uint8_t dlc, uint8_t addr, uint16_t index, uint8_t 
 	for (int i = 0; i < 4; i++) {
 		f.data[4 + i] = (uint8_t)(value >> (8 * i));
 	}
-	co_line_rx(&m.line, &f, m.now);
-}
-
-static void run_until(uint64_t at)
-{
-	while (true) {
-		uint64_t next = co_line_next_deadline(&m.line);
-
-		if (next == UINT64_MAX || next > at) {
-			break;
-		}
-		m.now = next;
-		co_line_process(&m.line, m.now);
-	}
-	m.now = at;
-	co_line_process(&m.line, m.now);
+	co_line_rx(&sim.line, &f, sim.now);
 }
 
 static int count(uint32_t id)
 {
 	int n = 0;
 
-	for (int i = 0; i < m.n_sent; i++) {
-		n += m.sent[i].id == id;
+	for (int i = 0; i < sim.n_sent; i++) {
+		n += sim.sent[i].id == id;
 	}
 	return n;
 }
 
 static const struct can_frame *nth(uint32_t id, int k)
 {
-	for (int i = 0; i < m.n_sent; i++) {
-		if (m.sent[i].id == id && k-- == 0) {
-			return &m.sent[i];
+	for (int i = 0; i < sim.n_sent; i++) {
+		if (sim.sent[i].id == id && k-- == 0) {
+			return &sim.sent[i];
 		}
 	}
 	return NULL;
@@ -153,18 +114,18 @@ static void setup_mpdo(bool rx_pdo, int n, uint32_t cob, uint8_t type, uint8_t m
 	uint16_t comm = (rx_pdo ? 0x1400 : 0x1800) + n;
 	uint16_t mapi = (rx_pdo ? 0x1600 : 0x1A00) + n;
 
-	zassert_equal(wr(comm, 1, cob | INVALID, 4), 0U);
-	zassert_equal(wr(comm, 2, type, 1), 0U);
-	zassert_equal(wr(mapi, 0, 0, 1), 0U);
-	zassert_equal(wr(mapi, 0, mode, 1), 0U);
-	zassert_equal(wr(comm, 1, cob, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, comm, 1, cob | INVALID, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, comm, 2, type, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, mapi, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, mapi, 0, mode, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, comm, 1, cob, 4), 0U);
 }
 
 static void before(void *f)
 {
 	memset(&m, 0, sizeof(m));
-	co_line_init_sim(&m.line, "sim", sink, NULL);
-	zassert_ok(co_node_init(&m.node, "dut", &m.line, &pdo_test_od_def, &m.ram, NODE_ID));
+	co_sim_init();
+	zassert_ok(co_node_init(&m.node, "dut", &sim.line, &pdo_test_od_def, &m.ram, NODE_ID));
 	co_rpdo_set_ind(&m.node, rpdo_ind, NULL);
 	zassert_ok(co_node_start(&m.node));
 	setup_mpdo(true, 1, DAM_RX, 255, CO_MPDO_DAM);
@@ -172,7 +133,7 @@ static void before(void *f)
 	setup_mpdo(false, 1, DAM_TX, 255, CO_MPDO_DAM);
 	setup_mpdo(false, 2, SAM_TX, 254, CO_MPDO_SAM);
 	rx8(0x000, 2, 0x01, NODE_ID, 0, 0); /* NMT start: bytes 0-1 = 01h, node-ID */
-	m.n_sent = 0;
+	sim.n_sent = 0;
 }
 
 ZTEST_SUITE(co_mpdo, NULL, NULL, before, NULL, NULL);
@@ -182,22 +143,25 @@ ZTEST_SUITE(co_mpdo, NULL, NULL, before, NULL, NULL);
 ZTEST(co_mpdo, test_mpdo_needs_event_driven_type)
 {
 	rx8(0x000, 2, 0x80, NODE_ID, 0, 0); /* Pre-operational: mapping writes allowed */
-	zassert_equal(wr(0x1403, 1, INVALID | 0x323, 4), 0U);
-	zassert_equal(wr(0x1403, 2, 1, 1), 0U, "synchronous RPDO");
-	zassert_equal(wr(0x1603, 0, 0, 1), 0U);
-	zassert_equal(wr(0x1603, 0, CO_MPDO_DAM, 1), CO_SDO_AB_INVALID_VALUE, "type 1: no MPDO");
-	zassert_equal(wr(0x1403, 2, 254, 1), 0U);
-	zassert_equal(wr(0x1603, 0, CO_MPDO_DAM, 1), 0U, "type 254: DAM-MPDO");
-	zassert_equal(wr(0x1403, 2, 0, 1), CO_SDO_AB_INVALID_VALUE, "MPDO stays event-driven");
-	zassert_equal(wr(0x1403, 2, 255, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1403, 1, INVALID | 0x323, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1403, 2, 1, 1), 0U, "synchronous RPDO");
+	zassert_equal(co_sim_write(&m.node, 0x1603, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1603, 0, CO_MPDO_DAM, 1), CO_SDO_AB_INVALID_VALUE,
+		      "type 1: no MPDO");
+	zassert_equal(co_sim_write(&m.node, 0x1403, 2, 254, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1603, 0, CO_MPDO_DAM, 1), 0U, "type 254: DAM-MPDO");
+	zassert_equal(co_sim_write(&m.node, 0x1403, 2, 0, 1), CO_SDO_AB_INVALID_VALUE,
+		      "MPDO stays event-driven");
+	zassert_equal(co_sim_write(&m.node, 0x1403, 2, 255, 1), 0U);
 
-	zassert_equal(wr(0x1803, 1, INVALID | 0x2A3, 4), 0U);
-	zassert_equal(wr(0x1803, 2, 0, 1), 0U);
-	zassert_equal(wr(0x1A03, 0, 0, 1), 0U);
-	zassert_equal(wr(0x1A03, 0, CO_MPDO_SAM, 1), CO_SDO_AB_INVALID_VALUE, "type 0: no MPDO");
-	zassert_equal(wr(0x1803, 2, 255, 1), 0U);
-	zassert_equal(wr(0x1A03, 0, CO_MPDO_SAM, 1), 0U);
-	zassert_equal(wr(0x1803, 2, 3, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&m.node, 0x1803, 1, INVALID | 0x2A3, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1803, 2, 0, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1A03, 0, 0, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1A03, 0, CO_MPDO_SAM, 1), CO_SDO_AB_INVALID_VALUE,
+		      "type 0: no MPDO");
+	zassert_equal(co_sim_write(&m.node, 0x1803, 2, 255, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1A03, 0, CO_MPDO_SAM, 1), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1803, 2, 3, 1), CO_SDO_AB_INVALID_VALUE);
 
 	rx8(0x000, 2, 0x01, NODE_ID, 0, 0);
 	zassert_equal(co_tpdo_send_req(&m.node, 1), -ENOTSUP, "an MPDO names its object");
@@ -228,7 +192,7 @@ ZTEST(co_mpdo, test_dam_to_self_to_all_and_to_others)
 	zassert_equal(stats().written, 3);
 	zassert_equal(stats().ignored, 2);
 	zassert_equal(m.n_rpdo_ind, 3, "the RPDO indication follows each write");
-	zassert_equal(m.n_sent, 0, "nothing is answered");
+	zassert_equal(sim.n_sent, 0, "nothing is answered");
 }
 
 ZTEST(co_mpdo, test_dam_refused_and_missing_object)
@@ -238,7 +202,7 @@ ZTEST(co_mpdo, test_dam_refused_and_missing_object)
 	rx8(DAM_RX, 8, 0x80 | NODE_ID, 0x2007, 0, 0x44);
 	rx8(DAM_RX, 8, 0x80 | NODE_ID, 0x1000, 0, 0x44);
 	zassert_equal(stats().refused, 3, "read-only, 8-byte object, const");
-	zassert_equal(m.n_sent, 0, "no frame back for a refused write (no abort for PDOs)");
+	zassert_equal(sim.n_sent, 0, "no frame back for a refused write (no abort for PDOs)");
 
 	rx8(DAM_RX, 8, 0x80 | NODE_ID, 0x3000, 0, 1);
 	zassert_equal(stats().missing, 1);
@@ -280,8 +244,9 @@ static uint64_t disp(uint8_t block, uint16_t local, uint8_t local_sub, uint8_t s
 ZTEST(co_mpdo, test_sam_consumer_dispatch_with_block)
 {
 	/* 6000h:01..03 of node 5 -> 2000h:04..06 here; 6100h:00 of node 6 -> 2001h. */
-	zassert_equal(wr(0x1FD0, 1, disp(3, 0x2000, 4, 1, 0x6000, 5), 8), 0U);
-	zassert_equal(wr(0x1FD0, 3, disp(0, 0x2001, 0, 0, 0x6100, 6), 8), 0U, "block 0 = 1");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(3, 0x2000, 4, 1, 0x6000, 5), 8), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 3, disp(0, 0x2001, 0, 0, 0x6100, 6), 8), 0U,
+		      "block 0 = 1");
 
 	rx8(SAM_RX, 8, 5, 0x6000, 1, 0x10);
 	rx8(SAM_RX, 8, 5, 0x6000, 3, 0x30);
@@ -307,7 +272,7 @@ ZTEST(co_mpdo, test_sam_consumer_dispatch_with_block)
 
 	zassert_equal(stats().written, 3);
 	zassert_equal(stats().ignored, 5);
-	zassert_equal(m.n_sent, 0);
+	zassert_equal(sim.n_sent, 0);
 }
 
 /* --- Producers --------------------------------------------------------------------------- */
@@ -317,8 +282,8 @@ ZTEST(co_mpdo, test_sam_producer_scanner_list)
 	const struct can_frame *f;
 
 	/* 2000h:02..04 (block 3) and 2002h:00 (block 0 = 1). */
-	zassert_equal(wr(0x1FA0, 1, (3U << 24) | (0x2000U << 8) | 2U, 4), 0U);
-	zassert_equal(wr(0x1FA0, 4, (0x2002U << 8), 4), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, (3U << 24) | (0x2000U << 8) | 2U, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 4, (0x2002U << 8), 4), 0U);
 	co_node_lock(&m.node);
 	zassert_ok(co_od_set_u8(co_node_od(&m.node), 0x2000, 4, 0x77, CO_OD_WRITER_APP));
 	zassert_ok(co_od_set_u32(co_node_od(&m.node), 0x2002, 0, 0xA1B2C3D4, CO_OD_WRITER_APP));
@@ -365,18 +330,18 @@ ZTEST(co_mpdo, test_dam_producer_and_inhibit_time)
 	zassert_equal(co_mpdo_dam_req(&m.node, 2, 5, 0x6200, 1, &v, 1), -EINVAL, "a SAM TPDO");
 
 	/* 10 ms inhibit time: one frame waits, a third request is refused. */
-	zassert_equal(wr(0x1801, 1, INVALID | DAM_TX, 4), 0U);
-	zassert_equal(wr(0x1801, 3, 100, 2), 0U);
-	zassert_equal(wr(0x1801, 1, DAM_TX, 4), 0U);
-	m.n_sent = 0;
+	zassert_equal(co_sim_write(&m.node, 0x1801, 1, INVALID | DAM_TX, 4), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1801, 3, 100, 2), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1801, 1, DAM_TX, 4), 0U);
+	sim.n_sent = 0;
 	zassert_ok(co_mpdo_dam_req(&m.node, 1, 5, 0x6200, 1, &v, 1));
 	zassert_ok(co_mpdo_dam_req(&m.node, 1, 5, 0x6200, 3, &v, 1), "waits");
 	zassert_equal(co_mpdo_dam_req(&m.node, 1, 5, 0x6200, 4, &v, 1), -EBUSY);
 	zassert_equal(count(DAM_TX), 1);
-	run_until(m.now + 10 * MS);
+	co_sim_run_until(sim.now + 10 * MS);
 	zassert_equal(count(DAM_TX), 2, "sent when the inhibit time ends");
 	zassert_equal(nth(DAM_TX, 1)->data[3], 3);
-	run_until(m.now + 100 * MS);
+	co_sim_run_until(sim.now + 100 * MS);
 	zassert_equal(count(DAM_TX), 2, "no event timer, nothing else");
 }
 
@@ -384,33 +349,37 @@ ZTEST(co_mpdo, test_dam_producer_and_inhibit_time)
 
 ZTEST(co_mpdo, test_scanner_and_dispatcher_write_rules)
 {
-	zassert_equal(wr(0x1FA0, 1, 0, 4), 0U, "0 = empty entry");
-	zassert_equal(wr(0x1FA0, 1, 0x3000U << 8, 4), CO_SDO_AB_NO_OBJECT);
-	zassert_equal(wr(0x1FA0, 1, (0x2000U << 8) | 9U, 4), CO_SDO_AB_NO_SUB);
-	zassert_equal(wr(0x1FA0, 1, (3U << 24) | (0x2000U << 8) | 7U, 4), CO_SDO_AB_NO_SUB,
-		      "the block runs past 2000h:08");
-	zassert_equal(wr(0x1FA0, 1, (2U << 24) | (0x2000U << 8) | 0xFFU, 4),
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0, 4), 0U, "0 = empty entry");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0x3000U << 8, 4), CO_SDO_AB_NO_OBJECT);
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, (0x2000U << 8) | 9U, 4), CO_SDO_AB_NO_SUB);
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, (3U << 24) | (0x2000U << 8) | 7U, 4),
+		      CO_SDO_AB_NO_SUB, "the block runs past 2000h:08");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, (2U << 24) | (0x2000U << 8) | 0xFFU, 4),
 		      CO_SDO_AB_INVALID_VALUE, "the block runs past sub-index FFh");
-	zassert_equal(wr(0x1FA0, 1, 0x2007U << 8, 4), CO_SDO_AB_NO_MAP, "8 bytes");
-	zassert_equal(wr(0x1FA0, 1, 0x2003U << 8, 4), CO_SDO_AB_NO_MAP, "PDOMapping=0");
-	zassert_equal(wr(0x1FA0, 1, 0x2008U << 8, 4), CO_SDO_AB_NO_MAP, "rww: RPDO only");
-	zassert_equal(wr(0x1FA0, 1, 0x2004U << 8, 4), 0U, "ro input");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0x2007U << 8, 4), CO_SDO_AB_NO_MAP,
+		      "8 bytes");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0x2003U << 8, 4), CO_SDO_AB_NO_MAP,
+		      "PDOMapping=0");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0x2008U << 8, 4), CO_SDO_AB_NO_MAP,
+		      "rww: RPDO only");
+	zassert_equal(co_sim_write(&m.node, 0x1FA0, 1, 0x2004U << 8, 4), 0U, "ro input");
 
-	zassert_equal(wr(0x1FD0, 1, 0, 8), 0U);
-	zassert_equal(wr(0x1FD0, 1, disp(1, 0x2000, 1, 1, 0x6000, 0), 8), CO_SDO_AB_INVALID_VALUE,
-		      "sender node-ID 0");
-	zassert_equal(wr(0x1FD0, 1, disp(1, 0x2000, 1, 1, 0x6000, 128), 8), CO_SDO_AB_INVALID_VALUE,
-		      "sender node-ID 128");
-	zassert_equal(wr(0x1FD0, 1, disp(2, 0x2000, 1, 0xFF, 0x6000, 5), 8),
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, 0, 8), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(1, 0x2000, 1, 1, 0x6000, 0), 8),
+		      CO_SDO_AB_INVALID_VALUE, "sender node-ID 0");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(1, 0x2000, 1, 1, 0x6000, 128), 8),
+		      CO_SDO_AB_INVALID_VALUE, "sender node-ID 128");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(2, 0x2000, 1, 0xFF, 0x6000, 5), 8),
 		      CO_SDO_AB_INVALID_VALUE, "sender block past FFh");
-	zassert_equal(wr(0x1FD0, 1, disp(1, 0x3000, 0, 1, 0x6000, 5), 8), CO_SDO_AB_NO_OBJECT);
-	zassert_equal(wr(0x1FD0, 1, disp(3, 0x2000, 7, 1, 0x6000, 5), 8), CO_SDO_AB_NO_SUB,
-		      "local block past 2000h:08");
-	zassert_equal(wr(0x1FD0, 1, disp(1, 0x2004, 0, 1, 0x6000, 5), 8), CO_SDO_AB_NO_MAP,
-		      "read-only local object");
-	zassert_equal(wr(0x1FD0, 1, disp(1, 0x2007, 0, 1, 0x6000, 5), 8), CO_SDO_AB_NO_MAP,
-		      "8-byte local object");
-	zassert_equal(wr(0x1FD0, 1, disp(8, 0x2000, 1, 1, 0x6000, 5), 8), 0U);
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(1, 0x3000, 0, 1, 0x6000, 5), 8),
+		      CO_SDO_AB_NO_OBJECT);
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(3, 0x2000, 7, 1, 0x6000, 5), 8),
+		      CO_SDO_AB_NO_SUB, "local block past 2000h:08");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(1, 0x2004, 0, 1, 0x6000, 5), 8),
+		      CO_SDO_AB_NO_MAP, "read-only local object");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(1, 0x2007, 0, 1, 0x6000, 5), 8),
+		      CO_SDO_AB_NO_MAP, "8-byte local object");
+	zassert_equal(co_sim_write(&m.node, 0x1FD0, 1, disp(8, 0x2000, 1, 1, 0x6000, 5), 8), 0U);
 }
 
 #endif /* CONFIG_CANOPEN_MPDO */
