@@ -135,6 +135,8 @@ def test_pytest_harness(full):
         "fake.pytest.test_image_runs": "passed",
         "fake.pytest.test_skipped": "skipped",
     }
+    log = (full.outdir / "native_posix" / s["path"] / "fake.pytest" / "handler.log").read_text()
+    assert "slowest 8 durations" in log, "the slowest cases are listed"
 
 
 def test_fixture_not_given_means_skipped(full):

@@ -117,6 +117,34 @@ ZTEST(co_line, test_exact_receivers_get_frames_in_registration_order)
 	zassert_equal(fx.log_time[0], 1000, "handler gets the reception time");
 }
 
+static struct co_rx *partner[2];
+
+/* Records, then removes the other receiver of the same COB-ID. */
+static void rx_unregister_partner(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	int tag = (int)(intptr_t)rx->user_data;
+
+	record(tag, now_us);
+	co_rx_unregister(partner[1 - tag]);
+}
+
+ZTEST(co_line, test_receiver_removed_during_dispatch_is_not_called)
+{
+	struct co_rx rx[2];
+	struct can_frame f = std_frame(0x181, 0);
+
+	/* Both are collected for the frame; the first one called removes the second. */
+	for (int i = 0; i < 2; i++) {
+		rx_fill(&rx[i], 0x181, 0x7ff, false, i);
+		rx[i].handler = rx_unregister_partner;
+		partner[i] = &rx[i];
+		zassert_ok(co_rx_register(&fx.line, &rx[i]));
+	}
+	co_line_rx(&fx.line, &f, 0);
+	zassert_equal(fx.log_len, 1, "only the receiver still registered was called");
+	co_rx_unregister(&rx[fx.log[0]]);
+}
+
 ZTEST(co_line, test_unregister_stops_delivery_and_frees_the_slot)
 {
 	struct co_rx rx[CONFIG_CANOPEN_LINE_RX_SLOTS + 1];

@@ -195,8 +195,8 @@ static void bench_cost(void)
 		best_sync = per < best_sync ? per : best_sync;
 	}
 	if (hook_calls < 7U * COST_OPS || sink_frames != 7U * 3U * COST_OPS) {
-		printf("pdo_bench: expected %u hook calls and %u TPDOs, got %u and %u\n",
-		       2U * 7U * COST_OPS, 7U * 3U * COST_OPS, hook_calls, sink_frames);
+		printf("pdo_bench: expected at least %u hook calls and %u TPDOs, got %u and %u\n",
+		       7U * COST_OPS, 7U * 3U * COST_OPS, hook_calls, sink_frames);
 		exit(1);
 	}
 	snprintf(extra, sizeof(extra), COLLECT_FMT, "bench_rpdo_loop", 7U * COST_OPS);
