@@ -6,6 +6,7 @@ folder, exactly as a sample would be built.
 """
 
 import os
+import re
 import subprocess
 import textwrap
 
@@ -200,3 +201,36 @@ source "Kconfig.safeline"
     cfg = dotconfig(build)
     assert cfg.get("CONFIG_TEST_CHOICE_B") == "y"
     assert "CONFIG_TEST_CHOICE_A" not in cfg
+
+
+@pytest.mark.parametrize("prj", ["CONFIG_CAN=n\nCONFIG_CANOPEN=y\n", "CONFIG_CANOPEN=y\n"],
+                         ids=["can-off", "can-unset"])
+def test_canopen_needs_can(tmp_path, prj):
+    # CANOPEN depends on CAN (it does not select it): without CAN the value does not stick.
+    app = make_app(tmp_path, prj=prj)
+    r = configure(app, tmp_path / "build")
+    assert r.returncode != 0
+    assert re.search(r"^error: CANOPEN \(defined at subsys/canopen/Kconfig:\d+\) was assigned "
+                     r"the value 'y' but got the value 'n'\. Its dependencies are not met: "
+                     r"CAN \(= n\)\.$", r.stderr, re.M), r.stderr
+    assert "nothing was written" in r.stderr
+    assert not (tmp_path / "build" / "zephyr" / ".config").exists()
+
+
+def test_canopen_with_can_always_has_the_object_dictionary(tmp_path):
+    app = make_app(tmp_path, prj="CONFIG_CAN=y\nCONFIG_CANOPEN=y\n")
+    build = tmp_path / "build"
+    r = configure(app, build)
+    assert r.returncode == 0, r.stderr
+    cfg = dotconfig(build)
+    assert cfg["CONFIG_CANOPEN"] == "y" and cfg["CONFIG_CANOPEN_OD"] == "y"
+    # CANOPEN_PDO implies CANOPEN_SYNC.
+    assert cfg["CONFIG_CANOPEN_PDO"] == "y" and cfg["CONFIG_CANOPEN_SYNC"] == "y"
+
+
+def test_object_dictionary_cannot_be_turned_off(tmp_path):
+    app = make_app(tmp_path, prj="CONFIG_CAN=y\nCONFIG_CANOPEN=y\nCONFIG_CANOPEN_OD=n\n")
+    r = configure(app, tmp_path / "build")
+    assert r.returncode != 0
+    assert re.search(r"^error: CANOPEN_OD \(defined at subsys/canopen/od/Kconfig:\d+\) was "
+                     r"assigned the value 'n' but got the value 'y'\.$", r.stderr, re.M), r.stderr
