@@ -24,6 +24,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <canopen/event.h>
 #include <canopen/line.h>
 
 #ifdef __cplusplus
@@ -95,6 +96,8 @@ struct co_emcy_status {
 	uint32_t overflows;
 };
 
+/* The service state exists when the service is built; the codes above always do. */
+#if defined(CONFIG_CANOPEN_EMCY)
 /** @cond INTERNAL_HIDDEN */
 struct co_emcy_active {
 	uint16_t code;
@@ -123,11 +126,12 @@ struct co_emcy {
 	bool enabled;
 	/* Our own writes to 1001h/1003h pass the refusing validate hooks. */
 	bool self_write;
+	/* Other services' errors and the lines' events reach EMCY as node events. */
+	struct co_listener listener;
 #if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
-	/* Line events: the node's listener, the controller state last reported, and the
-	 * timers that end the event-type errors 8110h and 8140h.
+	/* Line events: the controller state last reported, and the timers that end the
+	 * event-type errors 8110h and 8140h.
 	 */
-	struct co_line_listener listener;
 	struct co_timer overrun_timer;
 	struct co_timer recovered_timer;
 	uint8_t can_state;
@@ -138,6 +142,7 @@ struct co_emcy {
 	void *ind_user_data;
 };
 /** @endcond */
+#endif
 
 /**
  * @brief Report that an error condition appeared.

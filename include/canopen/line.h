@@ -7,7 +7,7 @@
  * @file
  * @brief CANopen line: one CAN interface, one thread, one receive table, one deadline list.
  *
- * A line is the unit of concurrency of the stack (DESIGN.md §3). Services register receivers
+ * A line is the unit of concurrency of the stack (doc/architecture.md). Services register receivers
  * (by COB-ID) and timers (by absolute deadline) on the line. The line dispatches each received
  * frame to its receivers and each expired timer to its handler, taking the owner's mutex (the
  * node's) around every call. The thread sleeps until the next frame or the next deadline; it
@@ -170,6 +170,17 @@ struct co_timer {
 	/** @endcond */
 };
 
+/**
+ * A node's membership of a line (embedded in the node): the line knows its nodes' locks, to
+ * deliver frames between them and to tell whether a thread holds one (co_line_owner_held()).
+ */
+struct co_line_member {
+	/** @cond INTERNAL_HIDDEN */
+	struct co_line_member *next;
+	const struct k_mutex *lock;
+	/** @endcond */
+};
+
 /** Counters of a line, for diagnostics and tests. */
 struct co_line_stats {
 	uint32_t rx_frames;    /**< Frames dispatched. */
@@ -180,6 +191,8 @@ struct co_line_stats {
 	uint32_t tx_dropped;   /**< Frames dropped because the TX queue was full. */
 	uint32_t tx_errors;    /**< Sends refused by the driver with an error. */
 	uint16_t tx_queue_max; /**< Highest TX queue occupancy seen. */
+	/** Receivers a frame did not reach: more matched than CONFIG_CANOPEN_LINE_RX_FANOUT. */
+	uint32_t rx_fanout_drops;
 };
 
 /** @cond INTERNAL_HIDDEN */
@@ -233,6 +246,7 @@ struct co_line {
 	uint64_t sim_now;
 	/* Nodes attached; from two on, frames a node sends reach the others (local delivery). */
 	uint8_t n_nodes;
+	struct co_line_member *members;
 
 	/* Received frames for the thread; in simulation, frames for local delivery only. */
 	struct k_msgq rxq;
@@ -462,9 +476,30 @@ int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 		      const struct k_mutex *origin);
 
 /**
- * @brief Count one more node on the line (called by co_node_init()).
+ * @brief Attach a node to the line (co_node_init() does it).
+ *
+ * @param line The line.
+ * @param m The node's membership record; @p lock is the node's mutex.
+ * @param lock The node's mutex.
  */
-void co_line_attach(struct co_line *line);
+void co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock);
+
+/**
+ * @brief Detach a node from the line, with every receiver and timer of its mutex.
+ *
+ * Safe on a record that is not attached.
+ */
+void co_line_detach(struct co_line *line, struct co_line_member *m);
+
+/**
+ * @brief Whether the calling thread holds the mutex of a node attached to @p line.
+ *
+ * A thread holding one must not wait for the line's thread (it may need that mutex).
+ */
+bool co_line_owner_held(struct co_line *line);
+
+/** @brief The line whose thread is calling, or NULL when called from any other thread. */
+struct co_line *co_line_current(void);
 
 /**
  * @brief Dispatch one received frame to its receivers.

@@ -5,13 +5,16 @@
 
 /**
  * @file
- * @brief CANopen node: one device (object dictionary + services) attached to a line.
+ * @brief CANopen node: one device (object dictionary + services) on one or two lines.
  *
- * A node has one recursive mutex. The line thread takes it around every dispatch to the
- * node's services; application threads take it through the API (every call locks inside;
- * co_node_lock()/co_node_unlock() group several calls, e.g. multi-step OD work). Callbacks run
- * in the line thread with it held, may call the API (the mutex is recursive) and must not
- * block.
+ * A node has one recursive mutex, and one lock rule (doc/architecture.md, "Locks"):
+ * - every public call of the node and its services (co_node_*, co_nmt_*, co_sdo_*, co_pdo_*,
+ *   ...) takes the mutex inside, so an application thread just calls it;
+ * - the dictionary accessors (co_od_*) never lock: the caller holds the mutex
+ *   (co_node_lock()/co_node_unlock() around multi-step OD work). With
+ *   CONFIG_CANOPEN_LOCK_CHECK an accessor called without it stops the program.
+ * Line threads take the mutex around every dispatch to the node's services, so callbacks run
+ * with it held; they may call the API (the mutex is recursive) and must not block.
  *
  * Life cycle: co_node_init() binds the node to its line, dictionary and node-ID;
  * co_node_start() runs the NMT Initialising state (reset application, reset communication),
@@ -26,100 +29,141 @@
 #ifndef SAFELINE_INCLUDE_CANOPEN_NODE_H_
 #define SAFELINE_INCLUDE_CANOPEN_NODE_H_
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include <zephyr/kernel.h>
+#include <zephyr/sys/slist.h>
+#include <zephyr/sys/util.h>
 
-#include <canopen/errctl.h>
+#include <canopen/event.h>
 #include <canopen/line.h>
 #include <canopen/nmt.h>
 #include <canopen/od.h>
-
-#if defined(CONFIG_CANOPEN_SDO_SERVER) || defined(__DOXYGEN__)
-#include <canopen/sdo.h>
-#endif
-#if defined(CONFIG_CANOPEN_EMCY) || defined(__DOXYGEN__)
-#include <canopen/emcy.h>
-#endif
-#if defined(CONFIG_CANOPEN_SYNC) || defined(__DOXYGEN__)
-#include <canopen/sync.h>
-#endif
-#if defined(CONFIG_CANOPEN_TIME) || defined(__DOXYGEN__)
-#include <canopen/time.h>
-#endif
-#if defined(CONFIG_CANOPEN_PDO) || defined(__DOXYGEN__)
-#include <canopen/pdo.h>
-#endif
-#if defined(CONFIG_CANOPEN_SDO_CLIENT) || defined(__DOXYGEN__)
-#include <canopen/sdo_cli.h>
-#endif
-#if defined(CONFIG_CANOPEN_MGR) || defined(__DOXYGEN__)
-#include <canopen/mgr.h>
-#endif
+#include <canopen/services.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** Node-ID of a node that has none yet (CiA 305: it waits for LSS to give it one). */
+#define CO_NODE_ID_UNCONFIGURED 0xFFU
+
+/** The lines a node can be attached to (CiA 302-6 names them default and redundant). */
+enum co_node_line_id {
+	/** The line given to co_node_init(); every node has it. */
+	CO_LINE_DEFAULT = 0,
+	/** A second line (co_node_attach_line()), for redundancy. */
+	CO_LINE_REDUNDANT = 1,
+};
+
+/** Number of lines a node can be attached to. */
+#define CO_NODE_LINES 2U
+
+/**
+ * @name Routes: which of its lines a node sends a frame on
+ * @{
+ */
+/** A set of lines, CO_ROUTE_* or co_node_route_of(). */
+typedef uint8_t co_route_t;
+/** The default line. */
+#define CO_ROUTE_DEFAULT   BIT(CO_LINE_DEFAULT)
+/** The redundant line. */
+#define CO_ROUTE_REDUNDANT BIT(CO_LINE_REDUNDANT)
+/** Both lines (those the node is attached to). */
+#define CO_ROUTE_BOTH      (CO_ROUTE_DEFAULT | CO_ROUTE_REDUNDANT)
+/** The node's active line: the default line unless co_node_set_active_line() chose another. */
+#define CO_ROUTE_ACTIVE    BIT(7)
+/** @} */
+
+/** @cond INTERNAL_HIDDEN */
+struct co_service;
+
+/* One of the node's lines, with what the node registered on it. */
+struct co_node_line {
+	struct co_line *line;
+	struct co_line_listener listener;
+	struct co_line_member member;
+};
+
+#define CO_NODE_SERVICE_MEMBER(name, member) member;
+/** @endcond */
 
 /** A CANopen node. Allocate statically; all fields are private. */
 struct co_node {
 	/** @cond INTERNAL_HIDDEN */
 	struct k_mutex lock;
 	const char *name;
-	struct co_line *line;
+	struct co_node_line lines[CO_NODE_LINES];
+	uint8_t active_line;
 	struct co_od od;
 	uint8_t node_id;
 	/* Node-ID to use from the next Reset Communication (LSS may change it). */
 	uint8_t pending_node_id;
 	bool started;
+	/* The services, from the list of canopen/services.h (set by co_node_init()). */
+	const struct co_service *const *services;
+	uint8_t n_services;
+	/* Services initialised so far (co_node_init() undoes them on failure). */
+	uint8_t n_services_up;
 	struct co_nmt nmt;
 	struct co_rx nmt_rx;
-	struct co_errctl ec;
-#if defined(CONFIG_CANOPEN_SDO_SERVER)
-	struct co_sdo_srv sdo_srv[CONFIG_CANOPEN_SDO_SERVERS];
-#endif
-#if defined(CONFIG_CANOPEN_EMCY)
-	struct co_emcy emcy;
-#endif
-#if defined(CONFIG_CANOPEN_SYNC)
-	struct co_sync sync;
-#endif
-#if defined(CONFIG_CANOPEN_TIME)
-	struct co_time_svc time;
-#endif
-#if defined(CONFIG_CANOPEN_PDO)
-	struct co_pdo pdo;
-#endif
-#if defined(CONFIG_CANOPEN_SDO_CLIENT)
-	struct co_sdo_cli sdo_cli[CONFIG_CANOPEN_SDO_CLIENTS];
-#endif
-#if defined(CONFIG_CANOPEN_MGR)
-	struct co_mgr mgr;
-#endif
+	sys_slist_t listeners;
+	/* Union of the listeners' masks: events nobody follows cost one test. */
+	uint32_t listen_mask;
+	/* Who refused the last refused NMT state change, and with what. */
+	const char *refused_by;
+	int refusal;
+	CO_NODE_SERVICES(CO_NODE_SERVICE_MEMBER)
 	/** @endcond */
 };
 
 /**
- * @brief Initialise a node.
+ * @brief Initialise a node on its default line.
+ *
+ * Binds the node to its line, dictionary and node-ID and initialises every service of
+ * canopen/services.h in order (each registers its dictionary hooks, receivers and
+ * listeners). On failure everything already done is undone: the node is left unregistered
+ * from the line and may be initialised again.
  *
  * @param node Node to initialise (statically allocated).
  * @param name Name for logs; must outlive the node.
- * @param line Line the node is attached to (initialised, started or not).
+ * @param line Default line (initialised, started or not).
  * @param def Generated dictionary description (NAME_od_def from scripts/eds2od).
  * @param ram The node's own RAM block for the dictionary (a struct NAME_od_ram).
- * @param node_id Node-ID 1..127.
+ * @param node_id Node-ID 1..127, or CO_NODE_ID_UNCONFIGURED for a node that waits for one.
  *
  * @retval 0 Initialised; the node is in Initialising until co_node_start().
- * @retval -EINVAL A NULL argument or a node-ID outside 1..127.
+ * @retval -EINVAL A NULL argument or a node-ID outside 1..127 and not CO_NODE_ID_UNCONFIGURED.
+ * @retval -ENOSPC A receiver, hook or listener did not fit in its table (line receive slots,
+ *         CONFIG_CANOPEN_OD_HOOKS, ...).
+ * @retval -EALREADY A receiver or listener of this node was registered already (the node
+ *         struct was not zeroed, or is initialised twice without success in between).
+ * @retval other negative errno As returned by a service's initialisation (see its header).
  */
 int co_node_init(struct co_node *node, const char *name, struct co_line *line,
 		 const struct co_od_def *def, void *ram, uint8_t node_id);
 
 /**
+ * @brief Attach the node to a second line (redundancy).
+ *
+ * Call after co_node_init() and before co_node_start(). Services register the receivers of
+ * that line at the next Reset Communication.
+ *
+ * @retval 0 Attached.
+ * @retval -EINVAL A NULL argument, or @p idx is not CO_LINE_REDUNDANT.
+ * @retval -EALREADY A line is attached there already, or it is the default line.
+ * @retval -EBUSY The node has been started.
+ */
+int co_node_attach_line(struct co_node *node, enum co_node_line_id idx, struct co_line *line);
+
+/**
  * @brief Start the node: reset application and communication, boot-up, Pre-operational.
  *
- * Call after the application has registered its hooks and indications. The boot-up
- * message goes out on the line.
+ * Call after the application has registered its hooks, indications and listeners. The
+ * boot-up message goes out on the default line. A node without node-ID
+ * (CO_NODE_ID_UNCONFIGURED) stays in Initialising and silent, running only the services that
+ * work unconfigured, until co_node_set_pending_id() and a reset give it one.
  *
  * @retval 0 Started.
  * @retval -EALREADY The node was started before.
@@ -135,30 +179,140 @@ void co_node_unlock(struct co_node *node);
 /**
  * @brief The node's object dictionary, for the co_od_* accessors.
  *
- * Call the accessors with the node's mutex held (co_node_lock()).
+ * The accessors require the node's mutex (co_node_lock()); with CONFIG_CANOPEN_LOCK_CHECK a
+ * call without it stops the program (doc/architecture.md, "Locks").
  */
 struct co_od *co_node_od(struct co_node *node);
 
-/** @brief The node's current node-ID. */
+/** @brief The node's current node-ID (CO_NODE_ID_UNCONFIGURED while it has none). */
 uint8_t co_node_id(const struct co_node *node);
 
-/** @brief The line the node is attached to. */
+/** @brief The node's default line. */
 struct co_line *co_node_line(struct co_node *node);
+
+/** @brief One of the node's lines, or NULL when none is attached there. */
+struct co_line *co_node_get_line(struct co_node *node, enum co_node_line_id idx);
 
 /**
  * @brief Set the node-ID used from the next Reset Communication (e.g. after LSS).
  *
  * @retval 0 Done.
- * @retval -EINVAL Not 1..127.
+ * @retval -EINVAL Not 1..127 and not CO_NODE_ID_UNCONFIGURED.
  */
 int co_node_set_pending_id(struct co_node *node, uint8_t node_id);
 
 /**
- * @brief Send a frame from the node on its line (the services' path to the bus).
+ * @brief Choose the node's active line (the route CO_ROUTE_ACTIVE), e.g. after a line switch.
  *
- * @return As co_line_send().
+ * @retval 0 Done.
+ * @retval -EINVAL No line is attached at @p idx.
  */
-int co_node_send(struct co_node *node, const struct can_frame *frame);
+int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx);
+
+/**
+ * @name For services: the node's path to its lines
+ *
+ * Services never hold a line pointer: they send through a route, register receivers on one
+ * of the node's lines, and run their timers on the node's default line thread. Every call
+ * here requires the node's mutex.
+ * @{
+ */
+
+/**
+ * @brief Send a frame on every line of @p route the node is attached to.
+ *
+ * @retval 0 Sent or queued on every line of the route.
+ * @retval -ENODEV The node has no line on that route.
+ * @retval other As co_line_send(), the first error of the lines of the route (the frame is
+ *         still sent on the others).
+ */
+int co_node_send(struct co_node *node, co_route_t route, const struct can_frame *frame);
+
+/** @brief The route that answers a frame received by @p rx (the line it came on). */
+co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx);
+
+/**
+ * @brief Free places in the TX queues of a route (the smallest of its lines).
+ *
+ * @return Frames that can be sent on every line of the route without an overflow; 0 when the
+ *         node has no line on the route.
+ */
+int co_node_tx_space(struct co_node *node, co_route_t route);
+
+/**
+ * @brief Register a receiver of the node on one of its lines.
+ *
+ * @retval 0 Registered.
+ * @retval -ENODEV No line attached at @p idx.
+ * @retval other As co_rx_register().
+ */
+int co_node_rx_register(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx);
+
+/**
+ * @brief Move a receiver of the node to a new COB-ID on one of its lines.
+ *
+ * @retval 0 Moved (or registered).
+ * @retval -ENODEV No line attached at @p idx.
+ * @retval other As co_rx_set_id().
+ */
+int co_node_rx_set_id(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx,
+		      uint32_t id);
+
+/** @brief Arm one of the node's timers (it runs in the default line's thread). */
+void co_node_timer_start(struct co_node *node, struct co_timer *timer, uint64_t deadline_us);
+
+/** @brief The node's time [µs] (co_line_time() of its default line). */
+uint64_t co_node_time(const struct co_node *node);
+
+/**
+ * @brief Give an event to the node's listeners, in registration order.
+ *
+ * For CO_EV_NMT_VETO the first refusal stops the round and is returned; every other event
+ * reaches every listener that follows it.
+ *
+ * @retval 0 Delivered (or, for a veto, accepted by all).
+ * @retval non-zero The refusal of a veto listener; @p who (if not NULL) gets its name.
+ */
+int co_node_publish(struct co_node *node, const struct co_event *ev, const char **who);
+
+/**
+ * @brief Report a communication error or its end (a CO_EV_ERROR event).
+ *
+ * The EMCY service (when built) raises or clears the emergency; other listeners (indicators,
+ * a bridge) see it too.
+ *
+ * @param node The node.
+ * @param code CiA 301 emergency error code.
+ * @param reg_bits Error register bits (CO_EMCY_REG_*).
+ * @param info First manufacturer byte, 0 if none.
+ * @param flags CO_ERROR_F_ACTIVE to raise (none to clear), CO_ERROR_F_BEHAVIOUR to apply 1029h.
+ */
+void co_node_error(struct co_node *node, uint16_t code, uint8_t reg_bits, uint8_t info,
+		   uint8_t flags);
+
+/** @brief The node's NMT state, for services (the node's mutex is held). */
+static inline enum co_nmt_state co_node_nmt_state(const struct co_node *node)
+{
+	return node->nmt.state;
+}
+
+/** @brief Whether the node has a node-ID (not CO_NODE_ID_UNCONFIGURED). */
+static inline bool co_node_is_configured(const struct co_node *node)
+{
+	return node->node_id != CO_NODE_ID_UNCONFIGURED;
+}
+
+/** @} */
+
+/**
+ * @brief Who refused the node's last refused NMT state change.
+ *
+ * @param node The node.
+ * @param err If not NULL, gets the refusal (the veto's return value).
+ * @return The refusing listener's name ("application" for the state indication), or NULL
+ *         when no change has been refused since the last reset.
+ */
+const char *co_nmt_get_refusal(struct co_node *node, int *err);
 
 #ifdef __cplusplus
 }

@@ -35,6 +35,8 @@
 #include <canopen/sdo_abort.h>
 #include <canopen/types.h>
 
+struct k_mutex;
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -360,6 +362,8 @@ struct co_od {
 	const struct co_od_def *def; /**< generated description */
 	uint8_t *ram;                /**< the node's RAM value block (struct NAME_od_ram) */
 	uint8_t node_id;             /**< node-ID used for $NODEID values */
+	/** the owning node's mutex, which accessors require (NULL: a dictionary of its own) */
+	const struct k_mutex *lock;
 	uint16_t n_hooks;
 	uint16_t hook_span; /**< largest index_last - index_first among hooks */
 	uint8_t n_prov;
@@ -686,6 +690,22 @@ uint32_t co_od_get_time(const struct co_od *od, uint16_t index, uint8_t sub, str
 /** @brief Write a TIME_OF_DAY or TIME_DIFFERENCE; see co_od_write_info() for the codes. */
 uint32_t co_od_set_time(struct co_od *od, uint16_t index, uint8_t sub, const struct co_time *t,
 			enum co_od_writer writer);
+
+/**
+ * @brief The value of an integer object as unsigned, or @p dflt if it cannot be read.
+ *
+ * For services reading their configuration objects, whose integer type may differ between
+ * dictionaries (where co_od_get_u32() and the like would refuse a type mismatch). Reads as
+ * the application, like the getters. The wire value of any size is taken as unsigned little
+ * endian; values wider than 32 bits give their low 32 bits.
+ *
+ * @param od   dictionary
+ * @param index object index
+ * @param sub  sub-index
+ * @param dflt returned when the object is absent, unreadable or empty
+ * @return the value, or @p dflt
+ */
+uint32_t co_od_uint(const struct co_od *od, uint16_t index, uint8_t sub, uint32_t dflt);
 /** @} */
 
 /**

@@ -28,6 +28,7 @@
 #include <stdint.h>
 
 #include <canopen/line.h>
+#include <canopen/event.h>
 #include <canopen/od.h>
 
 #ifdef __cplusplus
@@ -186,6 +187,8 @@ struct co_pdo {
 	uint64_t mpdo_scan; /* bit i: 1FA0h + i is in the dictionary */
 	uint64_t mpdo_disp; /* bit i: 1FD0h + i is in the dictionary */
 	struct co_mpdo_stats mpdo_stats;
+	/* SYNC reaches the PDOs as a node event. */
+	struct co_listener sync_listener;
 };
 /** @endcond */
 

@@ -101,6 +101,8 @@ struct co_sdo_srv_stats {
 struct co_sdo_srv {
 	struct co_node *node;
 	struct co_rx rx;
+	/* The line of the last request: answers go there. */
+	uint8_t route;
 	struct co_timer timer;
 	/* Chunked write into the dictionary (segmented and block download). */
 	struct co_od_xfer xfer;

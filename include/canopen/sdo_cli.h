@@ -21,7 +21,10 @@
  * including from any callback of the stack in a line thread (they never block or wait for the
  * bus). The confirmation runs later in the line thread of the node, with the node's mutex
  * held, exactly once per accepted request; it may start the next transfer. The blocking calls
- * (co_sdo_cli_upload()/co_sdo_cli_download()) are for application threads only.
+ * (co_sdo_cli_upload()/co_sdo_cli_download()) are for application threads only: they return
+ * -EDEADLK in any line thread or with the mutex of a node of the client's line held. Their
+ * result cannot be ignored (warn_unused_result): 0, a negative errno for the call, or
+ * -ECONNABORTED with the CiA 301 abort code in a required out-parameter.
  *
  * @defgroup co_sdo_cli SDO client
  * @ingroup canopen
@@ -220,28 +223,91 @@ bool co_sdo_cli_busy(struct co_sdo_cli *cli);
 void co_sdo_cli_get_stats(struct co_sdo_cli *cli, struct co_sdo_cli_stats *stats);
 
 /**
- * @brief Download and wait for the confirmation. Application threads only.
+ * @brief Download @p len bytes of @p data to index/sub of the server and wait for the result.
  *
- * @param[out] abort_code The abort code (0 on success); may be NULL.
- * @retval 0 Done; *abort_code tells the protocol result.
- * @retval -EDEADLK Called from the node's line thread, or with the node's mutex held (the
- *         line thread could not deliver the confirmation); use the _req form there.
- * @retval Other As co_sdo_cli_download_req().
+ * For application threads: runs co_sdo_cli_download_req() and waits for its confirmation.
+ * The result must be used (warn_unused_result): a failed transfer is reported only there.
+ *
+ * Timeouts. Each answer of the server is awaited at most CONFIG_CANOPEN_SDO_CLIENT_TIMEOUT,
+ * the protocol timeout of a request with @c timeout_ms 0: a server that stops answering is
+ * aborted with 05040000h and the call returns -ECONNABORTED. @p timeout bounds the whole
+ * call (all frames of the transfer): when it expires first, the client sends abort 05040000h
+ * to the server and the call returns -EAGAIN at once, without waiting for a line thread; the
+ * client is then idle (ready for the next transfer) and no longer uses @p data.
+ *
+ * Deadlocks. The confirmation comes from the line thread of the client's node, which takes
+ * the mutex of every node attached to that line. The call refuses with -EDEADLK, before
+ * starting anything, when it is made from any line thread (a callback of the stack) or while
+ * the calling thread holds the mutex of any node attached to the client's line, the client's
+ * own node included (co_node_lock()). Use co_sdo_cli_download_req() there.
+ *
+ * @param cli The client.
+ * @param index Index of the object on the server.
+ * @param sub Sub-index of the object on the server.
+ * @param data The value; used in place until the call returns. NULL only with @p len 0.
+ * @param len Bytes of the value (up to 4 GiB - 1).
+ * @param mode How to transfer (enum co_sdo_cli_mode).
+ * @param timeout Longest duration of the whole call: K_MSEC() and friends, an absolute
+ *        K_TIMEOUT_ABS_MS() and friends, or K_FOREVER (bounded by the protocol timeout
+ *        only). K_NO_WAIT is refused: a transfer cannot complete without waiting.
+ * @param[out] abort_code Required. The CiA 301 abort code when the call returns
+ *        -ECONNABORTED; 0 on every other return (written whenever it is not NULL).
+ *
+ * @retval 0 Done: the server confirmed the whole value.
+ * @retval -ECONNABORTED The transfer was aborted; *abort_code says why: the server's code,
+ *         the code the client sent (05040000h protocol timeout, 05040001h unexpected answer,
+ *         ...), or 08000000h when an NMT state change or a reconfiguration of the client
+ *         dropped it.
+ * @retval -EAGAIN @p timeout expired before the transfer ended; the client aborted it
+ *         towards the server with 05040000h.
+ * @retval -EDEADLK Called from a line thread, or with the mutex of a node of the client's
+ *         line held; nothing was started.
+ * @retval -EINVAL NULL @p cli or @p abort_code, @p timeout K_NO_WAIT, or an argument
+ *         co_sdo_cli_download_req() refuses (NULL data with @p len > 0, @p len too large).
+ * @retval -EBUSY A transfer is running on this client; nothing was started.
+ * @retval -ENOTCONN The client has no valid COB-IDs; nothing was started.
+ * @retval -ENETDOWN The node is not Pre-operational or Operational (or its line refused the
+ *         first frame); nothing was started.
+ * @retval -ENOBUFS, -EIO The first frame could not be sent (other errors of co_node_send()
+ *         pass through too); nothing was started.
  */
-int co_sdo_cli_download(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, const void *data,
-			size_t len, enum co_sdo_cli_mode mode, uint32_t timeout_ms,
-			uint32_t *abort_code);
+__attribute__((__warn_unused_result__)) int
+co_sdo_cli_download(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, const void *data,
+		    size_t len, enum co_sdo_cli_mode mode, k_timeout_t timeout,
+		    uint32_t *abort_code);
 
 /**
- * @brief Upload and wait for the confirmation. Application threads only.
+ * @brief Upload index/sub of the server into @p buf of @p cap bytes and wait for the result.
  *
- * @param[out] len Bytes received; may be NULL.
- * @param[out] abort_code The abort code (0 on success); may be NULL.
- * @return As co_sdo_cli_download().
+ * As co_sdo_cli_download(): same timeouts, same deadlock rule, same return contract. A value
+ * longer than @p cap is aborted with 05040005h (-ECONNABORTED); nothing is written past
+ * @p cap. @p buf is used in place until the call returns.
+ *
+ * @param cli The client.
+ * @param index Index of the object on the server.
+ * @param sub Sub-index of the object on the server.
+ * @param buf Buffer for the value; NULL only with @p cap 0.
+ * @param cap Bytes @p buf holds.
+ * @param[out] len Bytes written into @p buf (on -ECONNABORTED or -EAGAIN, how far the transfer
+ *        got; 0 when nothing was started); may be NULL.
+ * @param mode How to transfer (enum co_sdo_cli_mode).
+ * @param timeout Longest duration of the whole call, as co_sdo_cli_download().
+ * @param[out] abort_code Required; as co_sdo_cli_download().
+ *
+ * @retval 0 Done: *len bytes of the value are in @p buf.
+ * @retval -ECONNABORTED The transfer was aborted; *abort_code says why.
+ * @retval -EAGAIN @p timeout expired before the transfer ended (abort 05040000h sent).
+ * @retval -EDEADLK Called from a line thread, or with the mutex of a node of the client's
+ *         line held; nothing was started.
+ * @retval -EINVAL NULL @p cli or @p abort_code, @p timeout K_NO_WAIT, or NULL @p buf with
+ *         @p cap > 0.
+ * @retval -EBUSY, -ENOTCONN, -ENETDOWN, -ENOBUFS, -EIO As co_sdo_cli_download(); nothing was
+ *         started.
  */
-int co_sdo_cli_upload(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, void *buf, size_t cap,
-		      size_t *len, enum co_sdo_cli_mode mode, uint32_t timeout_ms,
-		      uint32_t *abort_code);
+__attribute__((__warn_unused_result__)) int
+co_sdo_cli_upload(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, void *buf, size_t cap,
+		  size_t *len, enum co_sdo_cli_mode mode, k_timeout_t timeout,
+		  uint32_t *abort_code);
 
 #ifdef __cplusplus
 }

@@ -190,6 +190,18 @@ const char *k_thread_name_get(k_tid_t thread);
  */
 int k_thread_name_copy(k_tid_t thread, char *buf, size_t size);
 
+#if defined(CONFIG_THREAD_CUSTOM_DATA) || defined(__DOXYGEN__)
+/**
+ * @brief Set the calling thread's custom data (one pointer per thread, as Zephyr's).
+ *
+ * @param value The value.
+ */
+void k_thread_custom_data_set(void *value);
+
+/** @brief The calling thread's custom data (NULL until set). */
+void *k_thread_custom_data_get(void);
+#endif
+
 /** @brief Current priority of @p thread (including a priority inherited from a mutex). */
 int k_thread_priority_get(k_tid_t thread);
 

@@ -21,7 +21,7 @@
 int k_mutex_init(struct k_mutex *mutex)
 {
 	z_waitq_init(&mutex->wait_q);
-	mutex->owner = NULL;
+	__atomic_store_n(&mutex->owner, NULL, __ATOMIC_RELAXED);
 	mutex->lock_count = 0U;
 	mutex->owner_orig_prio = K_LOWEST_APPLICATION_THREAD_PRIO;
 
@@ -53,7 +53,8 @@ int k_mutex_lock(struct k_mutex *mutex, k_timeout_t timeout)
 		mutex->owner_orig_prio =
 			(mutex->lock_count == 0U) ? cur->base.prio : mutex->owner_orig_prio;
 		mutex->lock_count++;
-		mutex->owner = cur;
+		/* Atomic: lock-rule checks read the owner without the kernel lock. */
+		__atomic_store_n(&mutex->owner, cur, __ATOMIC_RELAXED);
 		z_unlock();
 		return 0;
 	}
@@ -112,7 +113,7 @@ int k_mutex_unlock(struct k_mutex *mutex)
 	adjust_owner_prio(mutex, mutex->owner_orig_prio);
 
 	new_owner = z_unpend_first_thread(&mutex->wait_q);
-	mutex->owner = new_owner;
+	__atomic_store_n(&mutex->owner, new_owner, __ATOMIC_RELAXED);
 	if (new_owner != NULL) {
 		/* Hand over directly: the lock count stays 1 for the new owner. */
 		mutex->owner_orig_prio = new_owner->base.prio;

@@ -74,6 +74,9 @@ static void thread_base_init(struct k_thread *thread, int prio, uint8_t state)
 	thread->swap_data = NULL;
 	thread->start_ns = 0;
 	thread->name[0] = '\0';
+#if defined(CONFIG_THREAD_CUSTOM_DATA)
+	thread->custom_data = NULL;
+#endif
 	z_host(thread)->exit_jmp = NULL;
 	z_cond_init_monotonic(&z_host(thread)->cond);
 }
@@ -427,6 +430,18 @@ int k_thread_name_set(k_tid_t thread, const char *str)
 
 	return 0;
 }
+
+#if defined(CONFIG_THREAD_CUSTOM_DATA)
+void k_thread_custom_data_set(void *value)
+{
+	k_current_get()->custom_data = value;
+}
+
+void *k_thread_custom_data_get(void)
+{
+	return k_current_get()->custom_data;
+}
+#endif
 
 const char *k_thread_name_get(k_tid_t thread)
 {

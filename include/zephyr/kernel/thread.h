@@ -77,6 +77,9 @@ struct k_thread {
 	/* Absolute start time in ns since boot; INT64_MAX until k_thread_start(). */
 	int64_t start_ns;
 	char name[CONFIG_THREAD_MAX_NAME_LEN];
+#if defined(CONFIG_THREAD_CUSTOM_DATA)
+	void *custom_data;
+#endif
 	struct _thread_arch arch;
 	/** @endcond */
 };

@@ -348,14 +348,22 @@ void co_rx_unregister(struct co_rx *rx)
 
 int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id)
 {
+	struct co_line *old;
 	int err;
 
 	if (!id_fits(rx, id)) {
 		return -EINVAL;
 	}
+	/* A receiver on another line leaves that line's table under that line's lock; the two
+	 * table locks are never held together.
+	 */
+	old = rx_line_get(rx);
+	if (old != NULL && old != line) {
+		co_rx_unregister(rx);
+	}
 	k_mutex_lock(&line->lock, K_FOREVER);
 	if (rx->line != NULL) {
-		rx_unlink(rx->line, rx);
+		rx_unlink(line, rx);
 	}
 	rx->id = id;
 	err = rx_link(line, rx);
@@ -387,6 +395,21 @@ static void rx_call(struct co_line *line, struct co_rx *rx, const struct can_fra
 	}
 }
 
+/* Add a receiver to a frame's batch; one beyond CONFIG_CANOPEN_LINE_RX_FANOUT is counted. */
+static inline void batch_add(struct co_line *line, struct co_rx **batch, int *n, struct co_rx *rx)
+{
+	if (*n < CONFIG_CANOPEN_LINE_RX_FANOUT) {
+		batch[(*n)++] = rx;
+	} else {
+		if (line->stats.rx_fanout_drops == 0U) {
+			LOG_WRN("%s: a frame matched more than %d receivers; raise "
+				"CONFIG_CANOPEN_LINE_RX_FANOUT",
+				line->name, CONFIG_CANOPEN_LINE_RX_FANOUT);
+		}
+		line->stats.rx_fanout_drops++;
+	}
+}
+
 int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
 {
 	return co_line_dispatch(line, frame, now_us, NULL);
@@ -407,19 +430,16 @@ int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64
 	if (!ext) {
 		uint8_t slot = line->sff[frame->id & SFF_MASK];
 
-		if (slot != 0U) {
-			for (struct co_rx *rx = line->slots[slot - 1U];
-			     rx != NULL && n < (int)ARRAY_SIZE(batch); rx = rx->next) {
-				if (origin == NULL || rx->lock != origin) {
-					batch[n++] = rx;
-				}
+		for (struct co_rx *rx = slot != 0U ? line->slots[slot - 1U] : NULL; rx != NULL;
+		     rx = rx->next) {
+			if (origin == NULL || rx->lock != origin) {
+				batch_add(line, batch, &n, rx);
 			}
 		}
 	}
-	for (struct co_rx *rx = line->others; rx != NULL && n < (int)ARRAY_SIZE(batch);
-	     rx = rx->next) {
+	for (struct co_rx *rx = line->others; rx != NULL; rx = rx->next) {
 		if (rx_matches(rx, frame, ext) && (origin == NULL || rx->lock != origin)) {
-			batch[n++] = rx;
+			batch_add(line, batch, &n, rx);
 		}
 	}
 	if (origin == NULL) {
@@ -684,14 +704,79 @@ int co_line_tx_space(struct co_line *line)
 	return space;
 }
 
-void co_line_attach(struct co_line *line)
+void co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock)
 {
 	k_mutex_lock(&line->lock, K_FOREVER);
+	m->lock = lock;
+	m->next = line->members;
+	line->members = m;
 	if (line->n_nodes < UINT8_MAX) {
 		/* Read without the lock by every co_line_send_from(). */
 		__atomic_store_n(&line->n_nodes, (uint8_t)(line->n_nodes + 1U), __ATOMIC_RELAXED);
 	}
 	k_mutex_unlock(&line->lock);
+}
+
+/* Drop every receiver and timer of one owner (a node leaving the line). */
+static void purge_owner(struct co_line *line, const struct k_mutex *lock)
+{
+	for (unsigned int id = 0; id < CO_LINE_SFF_IDS; id++) {
+		uint8_t slot = line->sff[id];
+		struct co_rx *rx = slot != 0U ? line->slots[slot - 1U] : NULL;
+
+		while (rx != NULL) {
+			struct co_rx *next = rx->next;
+
+			if (rx->lock == lock) {
+				rx_unlink(line, rx);
+			}
+			rx = next;
+		}
+	}
+	for (struct co_rx *rx = line->others, *next; rx != NULL; rx = next) {
+		next = rx->next;
+		if (rx->lock == lock) {
+			rx_unlink(line, rx);
+		}
+	}
+	struct co_timer *t;
+	struct co_timer *tn;
+
+	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&line->timers, t, tn, node) {
+		if (t->lock == lock) {
+			timer_unlink(line, t);
+		}
+	}
+}
+
+void co_line_detach(struct co_line *line, struct co_line_member *m)
+{
+	k_mutex_lock(&line->lock, K_FOREVER);
+	for (struct co_line_member **pp = &line->members; *pp != NULL; pp = &(*pp)->next) {
+		if (*pp == m) {
+			purge_owner(line, m->lock);
+			*pp = m->next;
+			m->next = NULL;
+			__atomic_store_n(&line->n_nodes, (uint8_t)(line->n_nodes - 1U),
+					 __ATOMIC_RELAXED);
+			break;
+		}
+	}
+	k_mutex_unlock(&line->lock);
+}
+
+bool co_line_owner_held(struct co_line *line)
+{
+	k_tid_t self = k_current_get();
+	bool held = false;
+
+	k_mutex_lock(&line->lock, K_FOREVER);
+	for (const struct co_line_member *m = line->members; m != NULL && !held; m = m->next) {
+		/* Only this thread can make the answer true, so an unlocked look is exact. */
+		held = __atomic_load_n(&m->lock->owner, __ATOMIC_RELAXED) == self;
+	}
+	k_mutex_unlock(&line->lock);
+	return held;
 }
 
 int co_line_send_from(struct co_line *line, const struct can_frame *frame,

@@ -23,6 +23,21 @@
 
 LOG_MODULE_DECLARE(co_line, CONFIG_CANOPEN_LOG_LEVEL);
 
+struct co_line *co_line_current(void)
+{
+#if defined(CONFIG_THREAD_CUSTOM_DATA)
+	struct co_line *line = k_thread_custom_data_get();
+
+	/* Custom data of other threads may be anything: only an address match counts (no read
+	 * through the pointer).
+	 */
+	if (line != NULL && &line->thread == k_current_get()) {
+		return line;
+	}
+#endif
+	return NULL;
+}
+
 void co_line_wake(struct co_line *line)
 {
 	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
@@ -121,6 +136,10 @@ static void line_thread(void *p1, void *p2, void *p3)
 	struct co_line *line = p1;
 	struct co_line_rx_msg msg;
 
+#if defined(CONFIG_THREAD_CUSTOM_DATA)
+	/* co_line_current() finds the line from here: blocking calls refuse to run on it. */
+	k_thread_custom_data_set(line);
+#endif
 	while (!atomic_test_bit(&line->flags, CO_LINE_F_STOP)) {
 		uint64_t next = co_line_process(line, co_line_now());
 		k_timeout_t timeout = K_FOREVER;

@@ -3,7 +3,12 @@
  * SPDX-License-Identifier: Apache-2.0
  */
 
-/* A node: its mutex, dictionary, line, and the list of services it drives. */
+/*
+ * The node core: a node's mutex, dictionary and lines; its NMT slave state machine (CiA 301
+ * §7.3.2), which is the node's life cycle; its listeners; and the walk over its services.
+ * The core knows services only as the const records it is handed (core/services.c), so no
+ * service is called from here by name.
+ */
 
 #include <errno.h>
 #include <string.h>
@@ -17,80 +22,585 @@
 
 LOG_MODULE_REGISTER(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 
-int co_node_init(struct co_node *node, const char *name, struct co_line *line,
-		 const struct co_od_def *def, void *ram, uint8_t node_id)
+/* --- Listeners ---------------------------------------------------------------------------- */
+
+static void listen_mask_update(struct co_node *node)
+{
+	struct co_listener *l;
+	uint32_t mask = 0U;
+
+	SYS_SLIST_FOR_EACH_CONTAINER(&node->listeners, l, snode) {
+		mask |= l->mask;
+	}
+	node->listen_mask = mask;
+}
+
+int co_node_listener_add(struct co_node *node, struct co_listener *l)
+{
+	int err = 0;
+
+	if (node == NULL || l == NULL || l->cb == NULL) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	if (l->owner != NULL) {
+		err = -EALREADY;
+	} else {
+		l->owner = node;
+		sys_slist_append(&node->listeners, &l->snode);
+		node->listen_mask |= l->mask;
+	}
+	co_node_unlock(node);
+	return err;
+}
+
+void co_node_listener_remove(struct co_node *node, struct co_listener *l)
+{
+	if (node == NULL || l == NULL) {
+		return;
+	}
+	co_node_lock(node);
+	if (l->owner == node) {
+		(void)sys_slist_find_and_remove(&node->listeners, &l->snode);
+		l->owner = NULL;
+		listen_mask_update(node);
+	}
+	co_node_unlock(node);
+}
+
+int co_node_publish(struct co_node *node, const struct co_event *ev, const char **who)
+{
+	struct co_listener *l;
+	struct co_listener *next;
+	uint32_t bit = CO_EV_BIT(ev->type);
+
+	CO_ASSERT_LOCKED(&node->lock);
+	if ((node->listen_mask & bit) == 0U) {
+		return 0;
+	}
+	/* The safe walk lets a listener remove itself from its handler. */
+	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&node->listeners, l, next, snode) {
+		if ((l->mask & bit) == 0U) {
+			continue;
+		}
+		int ret = l->cb(node, ev, l->user_data);
+
+		if (ev->type == CO_EV_NMT_VETO && ret != 0) {
+			if (who != NULL) {
+				*who = l->name;
+			}
+			return ret;
+		}
+	}
+	return 0;
+}
+
+void co_node_error(struct co_node *node, uint16_t code, uint8_t reg_bits, uint8_t info,
+		   uint8_t flags)
+{
+	struct co_event ev = {
+		.type = CO_EV_ERROR,
+		.error = {.code = code, .reg_bits = reg_bits, .info = info, .flags = flags},
+	};
+
+	(void)co_node_publish(node, &ev, NULL);
+}
+
+/* --- Services ----------------------------------------------------------------------------- */
+
+/* Whether a service runs now: every service once the node has an ID, else only those marked. */
+static bool service_runs(const struct co_node *node, const struct co_service *svc)
+{
+	return co_node_is_configured(node) || (svc->flags & CO_SERVICE_F_UNCONFIGURED) != 0U;
+}
+
+static void services_reset_comm(struct co_node *node)
+{
+	for (size_t i = 0; i < node->n_services; i++) {
+		const struct co_service *svc = node->services[i];
+
+		if (svc->reset_comm != NULL && service_runs(node, svc)) {
+			svc->reset_comm(node);
+		}
+	}
+}
+
+static void services_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
+{
+	for (size_t i = 0; i < node->n_services; i++) {
+		const struct co_service *svc = node->services[i];
+
+		if (svc->set_state != NULL && service_runs(node, svc)) {
+			svc->set_state(node, from, to);
+		}
+	}
+}
+
+/* Undo the initialisation of the first node->n_services_up services, last first. */
+static void services_deinit(struct co_node *node)
+{
+	while (node->n_services_up > 0U) {
+		const struct co_service *svc = node->services[--node->n_services_up];
+
+		if (svc->deinit != NULL) {
+			svc->deinit(node);
+		}
+	}
+}
+
+/* --- NMT slave state machine -------------------------------------------------------------- */
+
+const char *co_nmt_state_str(enum co_nmt_state state)
+{
+	switch (state) {
+	case CO_NMT_INITIALISING:
+		return "INITIALISING";
+	case CO_NMT_STOPPED:
+		return "STOPPED";
+	case CO_NMT_OPERATIONAL:
+		return "OPERATIONAL";
+	case CO_NMT_PRE_OPERATIONAL:
+		return "PRE-OPERATIONAL";
+	default:
+		return "?";
+	}
+}
+
+/*
+ * The NMT commands (CiA 301 §7.3.2.2, figure 48): each leads to one state from any of
+ * Pre-operational, Operational and Stopped, or to a reset (the Initialising sub-states). A
+ * command for the state the node is in changes nothing.
+ */
+static const struct nmt_transition {
+	uint8_t cs;
+	bool reset;
+	enum co_nmt_state to;
+} nmt_transitions[] = {
+	{.cs = CO_NMT_CS_START, .to = CO_NMT_OPERATIONAL},
+	{.cs = CO_NMT_CS_STOP, .to = CO_NMT_STOPPED},
+	{.cs = CO_NMT_CS_ENTER_PRE_OPERATIONAL, .to = CO_NMT_PRE_OPERATIONAL},
+	{.cs = CO_NMT_CS_RESET_NODE, .reset = true, .to = CO_NMT_INITIALISING},
+	{.cs = CO_NMT_CS_RESET_COMMUNICATION, .reset = true, .to = CO_NMT_INITIALISING},
+};
+
+static void nmt_enter(struct co_node *node, enum co_nmt_state to)
+{
+	enum co_nmt_state from = node->nmt.state;
+	struct co_event ev = {.type = CO_EV_NMT_STATE, .nmt = {.from = from, .to = to}};
+
+	node->nmt.state = to;
+	LOG_INF("%s: %s -> %s", node->name, co_nmt_state_str(from), co_nmt_state_str(to));
+	services_set_state(node, from, to);
+	(void)co_node_publish(node, &ev, NULL);
+}
+
+/*
+ * A change among Pre-operational, Operational and Stopped, offered first to the application's
+ * state indication, then to every veto listener; any refusal keeps the node where it is.
+ */
+static int nmt_change(struct co_node *node, enum co_nmt_state to)
+{
+	enum co_nmt_state from = node->nmt.state;
+	struct co_event ev = {.type = CO_EV_NMT_VETO, .nmt = {.from = from, .to = to}};
+	const char *who = "application";
+	int veto = 0;
+
+	if (from == to) {
+		return 0;
+	}
+	if (node->nmt.state_ind != NULL) {
+		veto = node->nmt.state_ind(node, from, to, node->nmt.state_user_data);
+	}
+	if (veto == 0) {
+		veto = co_node_publish(node, &ev, &who);
+	}
+	if (veto != 0) {
+		node->refused_by = who;
+		node->refusal = veto;
+		LOG_INF("%s: change to %s refused by %s (%d)", node->name, co_nmt_state_str(to),
+			who, veto);
+		return -EPERM;
+	}
+	nmt_enter(node, to);
+	return 0;
+}
+
+static void send_bootup(struct co_node *node)
+{
+	struct can_frame f = {
+		.id = CO_NMT_EC_COB_ID + node->node_id,
+		.dlc = 1U,
+		.data = {0U},
+	};
+
+	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+}
+
+/*
+ * Reset Node or Reset Communication: Initialising, reload the dictionary areas, reconfigure
+ * every service, boot-up, Pre-operational (and Operational when self-starting). A node
+ * without node-ID stops in Initialising, silent, with only its unconfigured services
+ * running (CiA 305 §8.1: it waits for LSS).
+ */
+static void nmt_reset(struct co_node *node, enum co_nmt_cs cs)
+{
+	struct co_event ev = {.type = CO_EV_NMT_RESET, .reset = {.cs = cs}};
+
+	if (node->nmt.reset_ind != NULL) {
+		node->nmt.reset_ind(node, cs, node->nmt.reset_user_data);
+	}
+	(void)co_node_publish(node, &ev, NULL);
+	if (node->nmt.state != CO_NMT_INITIALISING) {
+		nmt_enter(node, CO_NMT_INITIALISING);
+	}
+	if (cs == CO_NMT_CS_RESET_NODE) {
+		co_od_reset_app(&node->od);
+	}
+	/* A node-ID configured by LSS takes effect here (CiA 305 §8.3.2.1). */
+	node->node_id = node->pending_node_id;
+	(void)co_od_set_node_id(&node->od, node->node_id);
+	co_od_reset_comm(&node->od);
+	node->refused_by = NULL;
+	node->refusal = 0;
+	services_reset_comm(node);
+	if (!co_node_is_configured(node)) {
+		LOG_INF("%s: no node-ID, waiting in INITIALISING", node->name);
+		return;
+	}
+
+	send_bootup(node);
+	nmt_enter(node, CO_NMT_PRE_OPERATIONAL);
+	if (node->nmt.autostart) {
+		(void)nmt_change(node, CO_NMT_OPERATIONAL);
+	}
+}
+
+static int nmt_command(struct co_node *node, uint8_t cs)
+{
+	const struct nmt_transition *t = NULL;
+
+	for (size_t i = 0; i < ARRAY_SIZE(nmt_transitions); i++) {
+		if (nmt_transitions[i].cs == cs) {
+			t = &nmt_transitions[i];
+			break;
+		}
+	}
+	if (t == NULL) {
+		return -EINVAL;
+	}
+	if (node->nmt.state == CO_NMT_INITIALISING) {
+		/* Only a reset leaves Initialising, and only once the node runs: an unconfigured
+		 * node is reset to take the node-ID LSS gave it.
+		 */
+		if (!node->started || co_node_is_configured(node) || !t->reset) {
+			return -EBUSY;
+		}
+	}
+	if (t->reset) {
+		nmt_reset(node, (enum co_nmt_cs)cs);
+		return 0;
+	}
+	return nmt_change(node, t->to);
+}
+
+/*
+ * 000h: [cs, node-ID]. CiA 301 defines only DLC 2; other lengths, RTR frames, commands for
+ * other nodes and unknown command specifiers are ignored without any reaction. A node
+ * without node-ID takes no NMT command (CiA 305: only LSS reaches it).
+ */
+static void nmt_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	struct co_node *node = rx->user_data;
+	uint8_t target;
+
+	ARG_UNUSED(now_us);
+	if (frame->dlc != 2U || (frame->flags & CAN_FRAME_RTR) != 0U ||
+	    !co_node_is_configured(node)) {
+		return;
+	}
+	target = frame->data[1];
+	if (target != 0U && target != node->node_id) {
+		return;
+	}
+	(void)nmt_command(node, frame->data[0]);
+}
+
+enum co_nmt_state co_nmt_get_state(struct co_node *node)
+{
+	enum co_nmt_state state;
+
+	co_node_lock(node);
+	state = node->nmt.state;
+	co_node_unlock(node);
+	return state;
+}
+
+int co_nmt_req(struct co_node *node, enum co_nmt_cs cs)
 {
 	int err;
 
-	if (node == NULL || line == NULL || def == NULL || ram == NULL || node_id < 1U ||
-	    node_id > 127U) {
+	co_node_lock(node);
+	err = nmt_command(node, (uint8_t)cs);
+	co_node_unlock(node);
+	return err;
+}
+
+void co_nmt_set_state_ind(struct co_node *node, co_nmt_state_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->nmt.state_ind = cb;
+	node->nmt.state_user_data = user_data;
+	co_node_unlock(node);
+}
+
+void co_nmt_set_reset_ind(struct co_node *node, co_nmt_reset_ind_t cb, void *user_data)
+{
+	co_node_lock(node);
+	node->nmt.reset_ind = cb;
+	node->nmt.reset_user_data = user_data;
+	co_node_unlock(node);
+}
+
+void co_nmt_set_autostart(struct co_node *node, bool autostart)
+{
+	co_node_lock(node);
+	node->nmt.autostart = autostart;
+	co_node_unlock(node);
+}
+
+const char *co_nmt_get_refusal(struct co_node *node, int *err)
+{
+	const char *who;
+
+	co_node_lock(node);
+	who = node->refused_by;
+	if (err != NULL) {
+		*err = node->refusal;
+	}
+	co_node_unlock(node);
+	return who;
+}
+
+/* --- Lines -------------------------------------------------------------------------------- */
+
+/* A line's events become the node's (CO_EV_LINE), with the line's index. */
+static void line_event(struct co_line_listener *l, enum co_line_event event, int arg)
+{
+	struct co_node *node = l->user_data;
+	struct co_event ev = {
+		.type = CO_EV_LINE,
+		.line = {.idx = (uint8_t)(l == &node->lines[CO_LINE_REDUNDANT].listener
+						  ? CO_LINE_REDUNDANT
+						  : CO_LINE_DEFAULT),
+			 .event = event,
+			 .arg = arg},
+	};
+
+	(void)co_node_publish(node, &ev, NULL);
+}
+
+static int line_join(struct co_node *node, enum co_node_line_id idx, struct co_line *line)
+{
+	struct co_node_line *nl = &node->lines[idx];
+	int err;
+
+	co_line_listener_init(&nl->listener, line_event, &node->lock, node);
+	err = co_line_listener_add(line, &nl->listener);
+	if (err != 0) {
+		return err;
+	}
+	co_line_attach(line, &nl->member, &node->lock);
+	nl->line = line;
+	return 0;
+}
+
+static void line_leave(struct co_node *node, enum co_node_line_id idx)
+{
+	struct co_node_line *nl = &node->lines[idx];
+
+	if (nl->line != NULL) {
+		co_line_listener_remove(&nl->listener);
+		co_line_detach(nl->line, &nl->member);
+		nl->line = NULL;
+	}
+}
+
+int co_node_attach_line(struct co_node *node, enum co_node_line_id idx, struct co_line *line)
+{
+	int err;
+
+	if (node == NULL || line == NULL || idx != CO_LINE_REDUNDANT) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	if (node->started) {
+		err = -EBUSY;
+	} else if (node->lines[idx].line != NULL || node->lines[CO_LINE_DEFAULT].line == line) {
+		err = -EALREADY;
+	} else {
+		err = line_join(node, idx, line);
+	}
+	co_node_unlock(node);
+	return err;
+}
+
+struct co_line *co_node_line(struct co_node *node)
+{
+	return node->lines[CO_LINE_DEFAULT].line;
+}
+
+struct co_line *co_node_get_line(struct co_node *node, enum co_node_line_id idx)
+{
+	return (unsigned int)idx < CO_NODE_LINES ? node->lines[idx].line : NULL;
+}
+
+int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
+{
+	int err = -EINVAL;
+
+	co_node_lock(node);
+	if ((unsigned int)idx < CO_NODE_LINES && node->lines[idx].line != NULL) {
+		node->active_line = (uint8_t)idx;
+		err = 0;
+	}
+	co_node_unlock(node);
+	return err;
+}
+
+static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
+{
+	if ((route & CO_ROUTE_ACTIVE) != 0U) {
+		route = (co_route_t)((route & ~CO_ROUTE_ACTIVE) | BIT(node->active_line));
+	}
+	return route;
+}
+
+int co_node_send(struct co_node *node, co_route_t route, const struct can_frame *frame)
+{
+	int ret = -ENODEV;
+	bool sent = false;
+
+	CO_ASSERT_LOCKED(&node->lock);
+	route = route_resolve(node, route);
+	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
+		struct co_line *line = node->lines[i].line;
+
+		if ((route & BIT(i)) == 0U || line == NULL) {
+			continue;
+		}
+		int err = co_line_send_from(line, frame, &node->lock);
+
+		if (!sent || (ret == 0 && err != 0)) {
+			ret = err;
+		}
+		sent = true;
+	}
+	return ret;
+}
+
+co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx)
+{
+	/* rx->line is stable while the receiver's handler runs (it holds the node's mutex). */
+	return (node->lines[CO_LINE_REDUNDANT].line != NULL &&
+		rx->line == node->lines[CO_LINE_REDUNDANT].line)
+		       ? CO_ROUTE_REDUNDANT
+		       : CO_ROUTE_DEFAULT;
+}
+
+int co_node_tx_space(struct co_node *node, co_route_t route)
+{
+	int space = INT32_MAX;
+
+	route = route_resolve(node, route);
+	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
+		if ((route & BIT(i)) != 0U && node->lines[i].line != NULL) {
+			space = MIN(space, co_line_tx_space(node->lines[i].line));
+		}
+	}
+	return space == INT32_MAX ? 0 : space;
+}
+
+int co_node_rx_register(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx)
+{
+	struct co_line *line = co_node_get_line(node, idx);
+
+	return line != NULL ? co_rx_register(line, rx) : -ENODEV;
+}
+
+int co_node_rx_set_id(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx, uint32_t id)
+{
+	struct co_line *line = co_node_get_line(node, idx);
+
+	return line != NULL ? co_rx_set_id(line, rx, id) : -ENODEV;
+}
+
+void co_node_timer_start(struct co_node *node, struct co_timer *timer, uint64_t deadline_us)
+{
+	CO_ASSERT_LOCKED(&node->lock);
+	co_timer_start(node->lines[CO_LINE_DEFAULT].line, timer, deadline_us);
+}
+
+uint64_t co_node_time(const struct co_node *node)
+{
+	return co_line_time(node->lines[CO_LINE_DEFAULT].line);
+}
+
+/* --- Life cycle --------------------------------------------------------------------------- */
+
+int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
+		  const struct co_od_def *def, void *ram, uint8_t node_id,
+		  const struct co_service *const *services, size_t n_services)
+{
+	int err;
+
+	if (node == NULL || line == NULL || def == NULL || ram == NULL ||
+	    !((node_id >= 1U && node_id <= 127U) || node_id == CO_NODE_ID_UNCONFIGURED) ||
+	    n_services > UINT8_MAX) {
 		return -EINVAL;
 	}
 	memset(node, 0, sizeof(*node));
 	k_mutex_init(&node->lock);
 	node->name = name;
-	node->line = line;
 	node->node_id = node_id;
 	node->pending_node_id = node_id;
 	node->nmt.state = CO_NMT_INITIALISING;
-	co_line_attach(line);
+	node->services = services;
+	node->n_services = (uint8_t)n_services;
+	sys_slist_init(&node->listeners);
 
 	err = co_od_init(&node->od, def, ram, node_id);
 	if (err != 0) {
 		return err;
 	}
-	co_nmt_init(node);
-	err = co_errctl_init(node);
-	if (err != 0) {
-		return err;
+	node->od.lock = &node->lock;
+
+	co_node_lock(node);
+	err = line_join(node, CO_LINE_DEFAULT, line);
+	if (err == 0) {
+		co_rx_init(&node->nmt_rx, CO_NMT_COB_ID, nmt_rx, &node->lock, node);
+		err = co_node_rx_register(node, CO_LINE_DEFAULT, &node->nmt_rx);
 	}
-#if defined(CONFIG_CANOPEN_EMCY)
-	err = co_emcy_init(node);
-	if (err != 0) {
-		return err;
-	}
-#endif
-#if defined(CONFIG_CANOPEN_SYNC)
-	err = co_sync_init(node);
-	if (err != 0) {
-		return err;
-	}
-#endif
-#if defined(CONFIG_CANOPEN_TIME)
-	err = co_time_init(node);
-	if (err != 0) {
-		return err;
-	}
-#endif
-#if defined(CONFIG_CANOPEN_PDO)
-	err = co_pdo_init(node);
-	if (err != 0) {
-		return err;
-	}
-#endif
-#if defined(CONFIG_CANOPEN_SDO_SERVER)
-	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
-		err = co_sdo_srv_init(&node->sdo_srv[i], node, i);
-		if (err != 0) {
-			return err;
+	while (err == 0 && node->n_services_up < node->n_services) {
+		const struct co_service *svc = node->services[node->n_services_up];
+
+		node->n_services_up++;
+		if (svc->init != NULL) {
+			err = svc->init(node);
+			if (err != 0) {
+				LOG_ERR("%s: %s: initialisation failed (%d)", name, svc->name, err);
+			}
 		}
 	}
-#endif
-#if defined(CONFIG_CANOPEN_SDO_CLIENT)
-	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
-		err = co_sdo_cli_init(&node->sdo_cli[i], node, i);
-		if (err != 0) {
-			return err;
-		}
-	}
-#endif
-#if defined(CONFIG_CANOPEN_MGR)
-	err = co_mgr_init(node);
 	if (err != 0) {
-		return err;
+		services_deinit(node);
+		co_rx_unregister(&node->nmt_rx);
+		/* Leaving the line drops every receiver and timer of the node's mutex. */
+		line_leave(node, CO_LINE_DEFAULT);
+		/* And a fresh dictionary drops every hook the services registered. */
+		(void)co_od_init(&node->od, def, ram, node_id);
 	}
-#endif
-	return 0;
+	co_node_unlock(node);
+	return err;
 }
 
 int co_node_start(struct co_node *node)
@@ -102,70 +612,10 @@ int co_node_start(struct co_node *node)
 		err = -EALREADY;
 	} else {
 		node->started = true;
-		co_nmt_boot(node);
+		nmt_reset(node, CO_NMT_CS_RESET_NODE);
 	}
 	co_node_unlock(node);
 	return err;
-}
-
-void co_node_services_reset_comm(struct co_node *node)
-{
-	co_errctl_reset_comm(node);
-#if defined(CONFIG_CANOPEN_EMCY)
-	co_emcy_reset_comm(node);
-#endif
-#if defined(CONFIG_CANOPEN_SYNC)
-	co_sync_reset_comm(node);
-#endif
-#if defined(CONFIG_CANOPEN_TIME)
-	co_time_reset_comm(node);
-#endif
-#if defined(CONFIG_CANOPEN_PDO)
-	co_pdo_reset_comm(node);
-#endif
-#if defined(CONFIG_CANOPEN_SDO_SERVER)
-	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
-		co_sdo_srv_reset_comm(&node->sdo_srv[i]);
-	}
-#endif
-#if defined(CONFIG_CANOPEN_SDO_CLIENT)
-	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
-		co_sdo_cli_reset_comm(&node->sdo_cli[i]);
-	}
-#endif
-#if defined(CONFIG_CANOPEN_MGR)
-	co_mgr_reset_comm(node);
-#endif
-}
-
-void co_node_services_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
-{
-	co_errctl_set_state(node, from, to);
-#if defined(CONFIG_CANOPEN_EMCY)
-	co_emcy_set_state(node, to);
-#endif
-#if defined(CONFIG_CANOPEN_SYNC)
-	co_sync_set_state(node, to);
-#endif
-#if defined(CONFIG_CANOPEN_TIME)
-	co_time_set_state(node, to);
-#endif
-#if defined(CONFIG_CANOPEN_PDO)
-	co_pdo_set_state(node, to);
-#endif
-#if defined(CONFIG_CANOPEN_SDO_SERVER)
-	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
-		co_sdo_srv_set_state(&node->sdo_srv[i], to);
-	}
-#endif
-#if defined(CONFIG_CANOPEN_SDO_CLIENT)
-	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
-		co_sdo_cli_set_state(&node->sdo_cli[i], to);
-	}
-#endif
-#if defined(CONFIG_CANOPEN_MGR)
-	co_mgr_set_state(node, to);
-#endif
 }
 
 void co_node_lock(struct co_node *node)
@@ -188,23 +638,13 @@ uint8_t co_node_id(const struct co_node *node)
 	return node->node_id;
 }
 
-struct co_line *co_node_line(struct co_node *node)
-{
-	return node->line;
-}
-
 int co_node_set_pending_id(struct co_node *node, uint8_t node_id)
 {
-	if (node_id < 1U || node_id > 127U) {
+	if (!((node_id >= 1U && node_id <= 127U) || node_id == CO_NODE_ID_UNCONFIGURED)) {
 		return -EINVAL;
 	}
 	co_node_lock(node);
 	node->pending_node_id = node_id;
 	co_node_unlock(node);
 	return 0;
-}
-
-int co_node_send(struct co_node *node, const struct can_frame *frame)
-{
-	return co_line_send_from(node->line, frame, &node->lock);
 }

@@ -31,6 +31,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/cob_id.h>
 #include <canopen/emcy.h>
 #include <canopen/node.h>
 
@@ -52,17 +53,6 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 #define BEH_PRE_OPERATIONAL 0U
 #define BEH_NO_CHANGE       1U
 #define BEH_STOPPED         2U
-
-static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint64_t dflt)
-{
-	uint8_t buf[8] = {0};
-	size_t len = 0;
-
-	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
-		return dflt;
-	}
-	return co_od_le_get(buf, len);
-}
 
 static void od_put(struct co_node *node, uint16_t index, uint8_t sub, uint64_t v, size_t len)
 {
@@ -98,6 +88,26 @@ static uint64_t inhibit_us(const struct co_emcy *em)
 	return (uint64_t)em->inhibit_100us * 100U;
 }
 
+/* An EMCY frame sent or received, for the node's listeners (CO_EV_EMCY). */
+static void publish(struct co_node *node, const struct can_frame *f, bool own)
+{
+	struct co_event ev = {
+		.type = CO_EV_EMCY,
+		.emcy = {.cob_id = (uint16_t)f->id,
+			 .own = own,
+			 .code = (uint16_t)(f->data[0] | (f->data[1] << 8)),
+			 .reg = f->data[2]},
+	};
+
+	if (own) {
+		ev.emcy.node_id = co_node_id(node);
+	} else if (f->id > CO_EMCY_COB_ID && f->id <= CO_EMCY_COB_ID + 127U) {
+		ev.emcy.node_id = (uint8_t)(f->id - CO_EMCY_COB_ID);
+	}
+	memcpy(ev.emcy.msef, &f->data[3], sizeof(ev.emcy.msef));
+	(void)co_node_publish(node, &ev, NULL);
+}
+
 static void transmit(struct co_node *node, const uint8_t data[8], uint64_t now_us)
 {
 	struct can_frame f = {
@@ -106,9 +116,10 @@ static void transmit(struct co_node *node, const uint8_t data[8], uint64_t now_u
 	};
 
 	memcpy(f.data, data, 8);
-	(void)co_node_send(node, &f);
+	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
 	node->emcy.last_tx_us = now_us;
 	node->emcy.sent_any = true;
+	publish(node, &f, true);
 }
 
 static bool producer_on(const struct co_emcy *em)
@@ -121,7 +132,7 @@ static void arm_inhibit(struct co_node *node)
 	struct co_emcy *em = &node->emcy;
 
 	if (em->q_count != 0U) {
-		co_timer_start(node->line, &em->inhibit_timer, em->last_tx_us + inhibit_us(em));
+		co_node_timer_start(node, &em->inhibit_timer, em->last_tx_us + inhibit_us(em));
 	} else {
 		co_timer_stop(&em->inhibit_timer);
 	}
@@ -151,7 +162,7 @@ static void flush_queue(struct co_emcy *em)
 static void emit(struct co_node *node, uint16_t code, uint8_t reg, const uint8_t msef[5])
 {
 	struct co_emcy *em = &node->emcy;
-	uint64_t now = co_line_time(node->line);
+	uint64_t now = co_node_time(node);
 	uint8_t data[8] = {(uint8_t)code, (uint8_t)(code >> 8), reg};
 
 	if (!producer_on(em)) {
@@ -185,13 +196,14 @@ static void history_push(struct co_node *node, uint32_t entry)
 	if (max == 0U) {
 		return;
 	}
-	count = (uint8_t)od_uint(node, IDX_ERR_FIELD, 0, 0U);
+	count = (uint8_t)co_od_uint(&node->od, IDX_ERR_FIELD, 0, 0U);
 	if (count > max) {
 		count = max;
 	}
 	/* Newest at sub1; the oldest drops off when full. */
 	for (uint8_t s = (count < max) ? count + 1U : max; s > 1U; s--) {
-		od_put(node, IDX_ERR_FIELD, s, od_uint(node, IDX_ERR_FIELD, s - 1U, 0U), 4U);
+		od_put(node, IDX_ERR_FIELD, s, co_od_uint(&node->od, IDX_ERR_FIELD, s - 1U, 0U),
+		       4U);
 	}
 	od_put(node, IDX_ERR_FIELD, 1, entry, 4U);
 	od_put(node, IDX_ERR_FIELD, 0, count < max ? count + 1U : max, 1U);
@@ -230,7 +242,7 @@ static uint32_t history_read_check(const struct co_od *od, const struct co_od_in
 {
 	struct co_node *node = user_data;
 
-	if (info->sub == 0U || info->sub <= od_uint(node, IDX_ERR_FIELD, 0, 0U)) {
+	if (info->sub == 0U || info->sub <= co_od_uint(&node->od, IDX_ERR_FIELD, 0, 0U)) {
 		return 0U;
 	}
 	return CO_SDO_AB_NO_DATA;
@@ -246,14 +258,6 @@ static uint32_t reg_validate(struct co_od *od, struct co_od_req *req, void *user
 }
 
 /* --- 1014h, 1015h ------------------------------------------------------------------------- */
-
-/* CiA 301 §7.3.5: identifiers reserved for other services. */
-static bool cob_restricted(uint32_t id)
-{
-	return id == 0x000U || (id >= 0x001U && id <= 0x07fU) || (id >= 0x101U && id <= 0x180U) ||
-	       (id >= 0x581U && id <= 0x5ffU) || (id >= 0x601U && id <= 0x67fU) ||
-	       (id >= 0x6e0U && id <= 0x6ffU) || (id >= 0x701U && id <= 0x7ffU);
-}
 
 static uint32_t cob_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
@@ -275,7 +279,7 @@ static uint32_t cob_validate(struct co_od *od, struct co_od_req *req, void *user
 	if ((old & COB_INVALID) == 0U && (old & 0x7ffU) != (v & 0x7ffU)) {
 		return CO_SDO_AB_INVALID_VALUE;
 	}
-	if (cob_restricted(v & 0x7ffU)) {
+	if (co_cob_id_restricted(v & 0x7ffU)) {
 		return CO_SDO_AB_INVALID_VALUE;
 	}
 	return 0U;
@@ -310,15 +314,17 @@ static void cons_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	uint8_t remote = 0U;
 
 	/* An EMCY is always 8 bytes (CiA 301 §7.2.7.3.1). */
-	if (frame->dlc != 8U || (frame->flags & CAN_FRAME_RTR) != 0U || !em->enabled ||
-	    em->ind == NULL) {
+	if (frame->dlc != 8U || (frame->flags & CAN_FRAME_RTR) != 0U || !em->enabled) {
 		return;
 	}
 	if (id > CO_EMCY_COB_ID && id <= CO_EMCY_COB_ID + 127U) {
 		remote = (uint8_t)(id - CO_EMCY_COB_ID);
 	}
-	em->ind(node, id, remote, (uint16_t)(frame->data[0] | (frame->data[1] << 8)),
-		frame->data[2], &frame->data[3], em->ind_user_data);
+	if (em->ind != NULL) {
+		em->ind(node, id, remote, (uint16_t)(frame->data[0] | (frame->data[1] << 8)),
+			frame->data[2], &frame->data[3], em->ind_user_data);
+	}
+	publish(node, frame, false);
 }
 
 static void cons_configure(struct co_node *node, int i, uint32_t v)
@@ -330,7 +336,7 @@ static void cons_configure(struct co_node *node, int i, uint32_t v)
 		return;
 	}
 	rx->id = v & 0x7ffU;
-	if (co_rx_register(node->line, rx) != 0) {
+	if (co_node_rx_register(node, CO_LINE_DEFAULT, rx) != 0) {
 		LOG_ERR("%s: no receive slot for EMCY consumer %03x", node->name, rx->id);
 	}
 }
@@ -404,11 +410,11 @@ static int clear_locked(struct co_node *node, uint16_t code)
 static void error_behaviour(struct co_node *node, uint8_t sub)
 {
 	/* An absent 1029h behaves as its default, 0 (Pre-operational). */
-	uint8_t beh = (uint8_t)od_uint(node, IDX_BEHAVIOUR, sub, BEH_PRE_OPERATIONAL);
+	uint8_t beh = (uint8_t)co_od_uint(&node->od, IDX_BEHAVIOUR, sub, BEH_PRE_OPERATIONAL);
 
 	switch (beh) {
 	case BEH_PRE_OPERATIONAL:
-		if (node->nmt.state == CO_NMT_OPERATIONAL) {
+		if (co_node_nmt_state(node) == CO_NMT_OPERATIONAL) {
 			(void)co_nmt_req(node, CO_NMT_CS_ENTER_PRE_OPERATIONAL);
 		}
 		break;
@@ -421,30 +427,22 @@ static void error_behaviour(struct co_node *node, uint8_t sub)
 	}
 }
 
-void co_emcy_comm_error(struct co_node *node, uint16_t code, uint8_t info, bool event, bool active)
+/* Another service's error (CO_EV_ERROR): raised once while present, cleared by its end. */
+static void service_error(struct co_node *node, uint16_t code, uint8_t reg_bits, uint8_t info,
+			  uint8_t flags)
 {
 	uint8_t msef[5] = {info};
 
-	if (event) {
-		if (find_active(&node->emcy, code) < 0) {
-			(void)raise_locked(node, code, CO_EMCY_REG_COMMUNICATION, msef, true);
-		}
-		error_behaviour(node, 1U);
-	} else if (!active) {
+	if ((flags & CO_ERROR_F_ACTIVE) == 0U) {
 		(void)clear_locked(node, code);
+		return;
 	}
-}
-
-void co_emcy_raise_internal(struct co_node *node, uint16_t code, uint8_t reg_bits)
-{
 	if (find_active(&node->emcy, code) < 0) {
-		(void)raise_locked(node, code, reg_bits, NULL, true);
+		(void)raise_locked(node, code, reg_bits, msef, true);
 	}
-}
-
-void co_emcy_clear_internal(struct co_node *node, uint16_t code)
-{
-	(void)clear_locked(node, code);
+	if ((flags & CO_ERROR_F_BEHAVIOUR) != 0U) {
+		error_behaviour(node, 1U);
+	}
 }
 
 /* --- Line events: 8110h, 8120h, 8140h ------------------------------------------------------ */
@@ -454,9 +452,9 @@ void co_emcy_clear_internal(struct co_node *node, uint16_t code)
 static void hold(struct co_node *node, struct co_timer *timer)
 {
 	if (CONFIG_CANOPEN_EMCY_COMM_HOLD_MS > 0) {
-		co_timer_start(node->line, timer,
-			       co_line_time(node->line) +
-				       (uint64_t)CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * 1000U);
+		co_node_timer_start(node, timer,
+				    co_node_time(node) +
+					    (uint64_t)CONFIG_CANOPEN_EMCY_COMM_HOLD_MS * 1000U);
 	}
 }
 
@@ -517,10 +515,8 @@ static void line_state(struct co_node *node, enum can_state to)
 	}
 }
 
-static void line_event(struct co_line_listener *l, enum co_line_event event, int arg)
+static void line_event(struct co_node *node, enum co_line_event event, int arg)
 {
-	struct co_node *node = l->user_data;
-
 	switch (event) {
 	case CO_LINE_EV_RX_OVERRUN:
 		line_overrun(node, CO_EMCY_OVERRUN_RX);
@@ -541,13 +537,9 @@ static void line_events_init(struct co_node *node)
 {
 	struct co_emcy *em = &node->emcy;
 
-	/* The node may be initialised again (tests): leave the old line's list first. */
-	co_line_listener_remove(&em->listener);
-	co_line_listener_init(&em->listener, line_event, &node->lock, node);
 	co_timer_init(&em->overrun_timer, overrun_expired, &node->lock, node);
 	co_timer_init(&em->recovered_timer, recovered_expired, &node->lock, node);
 	em->can_state = (uint8_t)CAN_STATE_ERROR_ACTIVE;
-	(void)co_line_listener_add(node->line, &em->listener);
 }
 
 static void line_events_reset_comm(struct co_node *node)
@@ -569,29 +561,73 @@ static void line_events_reset_comm(struct co_node *node)
 
 #endif /* CONFIG_CANOPEN_EMCY_LINE_EVENTS */
 
+/* --- Events: other services' errors and the lines' events --------------------------------- */
+
+static int node_event(struct co_node *node, const struct co_event *ev, void *user_data)
+{
+	ARG_UNUSED(user_data);
+	if (ev->type == CO_EV_ERROR) {
+		service_error(node, ev->error.code, ev->error.reg_bits, ev->error.info,
+			      ev->error.flags);
+	}
+#if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
+	/* The controller state of the default line; a redundant line's state is the
+	 * redundancy service's to judge.
+	 */
+	if (ev->type == CO_EV_LINE && ev->line.idx == CO_LINE_DEFAULT) {
+		line_event(node, ev->line.event, ev->line.arg);
+	}
+#endif
+	return 0;
+}
+
 /* --- Node interface ----------------------------------------------------------------------- */
 
-int co_emcy_init(struct co_node *node)
+static int emcy_init(struct co_node *node)
 {
 	struct co_emcy *em = &node->emcy;
 	const struct co_od_hook hooks[] = {
-		{IDX_ERR_REG, IDX_ERR_REG, 0, 0, reg_validate, NULL, node},
+		{
+			.index_first = IDX_ERR_REG,
+			.index_last = IDX_ERR_REG,
+			.validate = reg_validate,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_ERR_FIELD,
+			.index_last = IDX_ERR_FIELD,
+			.sub_first = 0,
+			.sub_last = 254,
+			.validate = history_validate,
+			.notify = history_notify,
+			.user_data = node,
 #if defined(CO_OD_HOOK_READ_CHECK)
-		{.index_first = IDX_ERR_FIELD,
-		 .index_last = IDX_ERR_FIELD,
-		 .sub_first = 0,
-		 .sub_last = 254,
-		 .validate = history_validate,
-		 .notify = history_notify,
-		 .user_data = node,
-		 .read_check = history_read_check},
-#else
-		{IDX_ERR_FIELD, IDX_ERR_FIELD, 0, 254, history_validate, history_notify, node},
+			.read_check = history_read_check,
 #endif
-		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
-		{IDX_INHIBIT, IDX_INHIBIT, 0, 0, NULL, inhibit_notify, node},
-		{IDX_CONSUMER, IDX_CONSUMER, 1, 127, NULL, cons_notify, node},
+		},
+		{
+			.index_first = IDX_COB_ID,
+			.index_last = IDX_COB_ID,
+			.validate = cob_validate,
+			.notify = cob_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_INHIBIT,
+			.index_last = IDX_INHIBIT,
+			.notify = inhibit_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_CONSUMER,
+			.index_last = IDX_CONSUMER,
+			.sub_first = 1,
+			.sub_last = 127,
+			.notify = cons_notify,
+			.user_data = node,
+		},
 	};
+	int err;
 
 	co_timer_init(&em->inhibit_timer, inhibit_expired, &node->lock, node);
 	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
@@ -601,10 +637,16 @@ int co_emcy_init(struct co_node *node)
 #if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
 	line_events_init(node);
 #endif
+	co_listener_init(&em->listener, "emcy", CO_EV_BIT(CO_EV_ERROR) | CO_EV_BIT(CO_EV_LINE),
+			 node_event, NULL);
+	err = co_node_listener_add(node, &em->listener);
+	if (err != 0) {
+		return err;
+	}
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
-void co_emcy_reset_comm(struct co_node *node)
+static void emcy_reset_comm(struct co_node *node)
 {
 	struct co_emcy *em = &node->emcy;
 	struct co_od_info info;
@@ -615,8 +657,8 @@ void co_emcy_reset_comm(struct co_node *node)
 	em->overflows = 0U;
 	em->sent_any = false;
 	/* Without 1014h there is no EMCY producer. */
-	em->cob_id = (uint32_t)od_uint(node, IDX_COB_ID, 0, COB_INVALID);
-	em->inhibit_100us = (uint16_t)od_uint(node, IDX_INHIBIT, 0, 0U);
+	em->cob_id = (uint32_t)co_od_uint(&node->od, IDX_COB_ID, 0, COB_INVALID);
+	em->inhibit_100us = (uint16_t)co_od_uint(&node->od, IDX_INHIBIT, 0, 0U);
 
 	/* 1003h entries served: the dictionary's array, at most CONFIG_CANOPEN_EMCY_HISTORY. */
 	while (n < CONFIG_CANOPEN_EMCY_HISTORY &&
@@ -638,22 +680,23 @@ void co_emcy_reset_comm(struct co_node *node)
 #endif
 	update_reg(node);
 
-	count = (uint8_t)od_uint(node, IDX_CONSUMER, 0, 0U);
+	count = (uint8_t)co_od_uint(&node->od, IDX_CONSUMER, 0, 0U);
 	if (count > CONFIG_CANOPEN_EMCY_CONSUMERS) {
 		LOG_WRN("%s: 1028h has %u entries, CONFIG_CANOPEN_EMCY_CONSUMERS=%d are served",
 			node->name, count, CONFIG_CANOPEN_EMCY_CONSUMERS);
 	}
 	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
-		uint32_t v = i < count ? (uint32_t)od_uint(node, IDX_CONSUMER, (uint8_t)(i + 1),
-							   COB_INVALID)
+		uint32_t v = i < count ? (uint32_t)co_od_uint(&node->od, IDX_CONSUMER,
+							      (uint8_t)(i + 1), COB_INVALID)
 				       : COB_INVALID;
 
 		cons_configure(node, i, v);
 	}
 }
 
-void co_emcy_set_state(struct co_node *node, enum co_nmt_state to)
+static void emcy_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
+	ARG_UNUSED(from);
 	struct co_emcy *em = &node->emcy;
 
 	/* CiA 301 Table 82: EMCY in Pre-operational and Operational only. */
@@ -662,6 +705,13 @@ void co_emcy_set_state(struct co_node *node, enum co_nmt_state to)
 		flush_queue(em);
 	}
 }
+
+const struct co_service co_service_emcy = {
+	.name = "emcy",
+	.init = emcy_init,
+	.reset_comm = emcy_reset_comm,
+	.set_state = emcy_set_state,
+};
 
 /* --- API ---------------------------------------------------------------------------------- */
 

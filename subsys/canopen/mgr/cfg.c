@@ -194,22 +194,11 @@ int co_cfg_get_expected(struct co_cfg *cfg, uint8_t id, uint32_t *date, uint32_t
 	    time == NULL) {
 		return -EINVAL;
 	}
-	uint8_t buf[4] = {0};
-	size_t len;
-
 	co_node_lock(cfg->node);
-	struct co_od *od = co_node_od(cfg->node);
+	const struct co_od *od = co_node_od(cfg->node);
 
-	*date = co_od_read(od, CO_CFG_INDEX_DATE, id, 0, buf, sizeof(buf), &len,
-			   CO_OD_WRITER_APP) == 0U &&
-				len == 4U
-			? get_u32(buf)
-			: 0U;
-	*time = co_od_read(od, CO_CFG_INDEX_TIME, id, 0, buf, sizeof(buf), &len,
-			   CO_OD_WRITER_APP) == 0U &&
-				len == 4U
-			? get_u32(buf)
-			: 0U;
+	*date = co_od_uint(od, CO_CFG_INDEX_DATE, id, 0U);
+	*time = co_od_uint(od, CO_CFG_INDEX_TIME, id, 0U);
 	co_node_unlock(cfg->node);
 	return 0;
 }
@@ -534,8 +523,7 @@ static int job_start(struct co_cfg *cfg, struct co_sdo_cli *cli, uint8_t id, co_
 	job->active = true;
 	if (n == 0U) {
 		/* Confirm from the line thread, never inside the request. */
-		co_timer_start(co_node_line(cfg->node), &job->defer,
-			       co_line_time(co_node_line(cfg->node)));
+		co_node_timer_start(cfg->node, &job->defer, co_node_time(cfg->node));
 		return 0;
 	}
 	int ret = job_send_next(job);
@@ -723,8 +711,7 @@ static uint32_t all_nothing(struct co_cfg *cfg)
 			job->id = CO_CFG_ALL;
 			job->remaining = 0;
 			job->active = true;
-			co_timer_start(co_node_line(cfg->node), &job->defer,
-				       co_line_time(co_node_line(cfg->node)));
+			co_node_timer_start(cfg->node, &job->defer, co_node_time(cfg->node));
 			return CO_OD_HANDLED;
 		}
 	}

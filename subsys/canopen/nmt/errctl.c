@@ -23,6 +23,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/emcy.h>
 #include <canopen/errctl.h>
 #include <canopen/node.h>
 
@@ -43,18 +44,7 @@ enum hb_mon {
 
 static uint64_t now_of(struct co_node *node)
 {
-	return co_line_time(node->line);
-}
-
-static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub)
-{
-	uint8_t buf[8] = {0};
-	size_t len = 0;
-
-	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
-		return 0U;
-	}
-	return co_od_le_get(buf, len);
+	return co_node_time(node);
 }
 
 static void send_state(struct co_node *node, uint8_t toggle)
@@ -62,30 +52,30 @@ static void send_state(struct co_node *node, uint8_t toggle)
 	struct can_frame f = {
 		.id = CO_NMT_EC_COB_ID + node->node_id,
 		.dlc = 1U,
-		.data = {(uint8_t)(toggle | (uint8_t)node->nmt.state)},
+		.data = {(uint8_t)(toggle | (uint8_t)co_node_nmt_state(node))},
 	};
 
-	(void)co_node_send(node, &f);
+	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
 }
 
 /*
- * A heartbeat or life guarding event (@p event true) or its end: EMCY 8130h and the error
- * behaviour 1029h sub1 (emcy/emcy.c). The code stays active while any monitor is lost.
+ * A heartbeat or life guarding event (@p event true) or its end, as a node error: 8130h with
+ * the error behaviour 1029h sub1 (the EMCY service acts on it). The error stays while any
+ * monitor is lost, so an end is reported only when the last one ends.
  */
 static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
 {
-#if defined(CONFIG_CANOPEN_EMCY)
 	bool active = node->ec.life_lost;
 
 	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
 		active = active || node->ec.hbc[i].mon == HB_LOST;
 	}
-	co_emcy_comm_error(node, CO_EMCY_HEARTBEAT, remote_id, event, active);
-#else
-	ARG_UNUSED(node);
-	ARG_UNUSED(remote_id);
-	ARG_UNUSED(event);
-#endif
+	if (event) {
+		co_node_error(node, CO_EMCY_HEARTBEAT, CO_EMCY_REG_COMMUNICATION, remote_id,
+			      CO_ERROR_F_ACTIVE | CO_ERROR_F_BEHAVIOUR);
+	} else if (!active) {
+		co_node_error(node, CO_EMCY_HEARTBEAT, CO_EMCY_REG_COMMUNICATION, remote_id, 0U);
+	}
 }
 
 /* --- Heartbeat producer ------------------------------------------------------------------- */
@@ -101,20 +91,20 @@ static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
 	if (co_time_before_eq(next, now_us)) {
 		next = now_us + period;
 	}
-	co_timer_start(node->line, timer, next);
+	co_node_timer_start(node, timer, next);
 }
 
 static void hb_restart(struct co_node *node, bool send_now)
 {
 	co_timer_stop(&node->ec.hb_timer);
-	if (node->ec.hb_period_ms == 0U || node->nmt.state == CO_NMT_INITIALISING) {
+	if (node->ec.hb_period_ms == 0U || co_node_nmt_state(node) == CO_NMT_INITIALISING) {
 		return;
 	}
 	if (send_now) {
 		send_state(node, 0U);
 	}
-	co_timer_start(node->line, &node->ec.hb_timer,
-		       now_of(node) + (uint64_t)node->ec.hb_period_ms * 1000U);
+	co_node_timer_start(node, &node->ec.hb_timer,
+			    now_of(node) + (uint64_t)node->ec.hb_period_ms * 1000U);
 }
 
 static void hb_producer_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
@@ -131,11 +121,16 @@ static void hb_producer_notify(struct co_od *od, const struct co_od_req *req, vo
 static void hbc_report(struct co_hb_entry *e, enum co_hb_event ev)
 {
 	struct co_node *node = e->node;
+	struct co_event event = {
+		.type = CO_EV_HB,
+		.hb = {.node_id = e->remote_id, .event = ev, .state = (enum co_nmt_state)e->state},
+	};
 
 	if (node->ec.hb_ind != NULL) {
 		node->ec.hb_ind(node, e->remote_id, ev, (enum co_nmt_state)e->state,
 				node->ec.hb_user_data);
 	}
+	(void)co_node_publish(node, &event, NULL);
 }
 
 static void hbc_timeout(struct co_timer *timer, uint64_t now_us)
@@ -174,7 +169,7 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		}
 		return;
 	}
-	co_timer_start(e->node->line, &e->timer, now_us + (uint64_t)e->time_ms * 1000U);
+	co_node_timer_start(e->node, &e->timer, now_us + (uint64_t)e->time_ms * 1000U);
 	if (e->mon == HB_IDLE) {
 		e->mon = HB_ACTIVE;
 		hbc_report(e, CO_HB_EV_STARTED);
@@ -215,7 +210,7 @@ static void hbc_configure(struct co_node *node, int i, uint32_t value)
 	e->remote_id = (uint8_t)(value >> 16);
 	e->time_ms = (uint16_t)value;
 	e->rx.id = CO_NMT_EC_COB_ID + e->remote_id;
-	if (co_rx_register(node->line, &e->rx) != 0) {
+	if (co_node_rx_register(node, CO_LINE_DEFAULT, &e->rx) != 0) {
 		LOG_ERR("%s: no receive slot to monitor node %u", node->name, e->remote_id);
 	}
 }
@@ -231,9 +226,9 @@ static uint32_t hbc_validate(struct co_od *od, struct co_od_req *req, void *user
 	if (sub == 0U || !hbc_value_active(v)) {
 		return 0U;
 	}
-	count = (uint8_t)od_uint(node, IDX_HB_CONSUMER, 0);
+	count = (uint8_t)co_od_uint(&node->od, IDX_HB_CONSUMER, 0, 0U);
 	for (uint8_t s = 1; s <= count; s++) {
-		uint32_t other = (uint32_t)od_uint(node, IDX_HB_CONSUMER, s);
+		uint32_t other = (uint32_t)co_od_uint(&node->od, IDX_HB_CONSUMER, s, 0U);
 
 		if (s != sub && hbc_value_active(other) &&
 		    (uint8_t)(other >> 16) == (uint8_t)(v >> 16)) {
@@ -255,6 +250,16 @@ static void hbc_notify(struct co_od *od, const struct co_od_req *req, void *user
 
 /* --- Node guarding and life guarding ------------------------------------------------------ */
 
+static void life_report(struct co_node *node, bool lost)
+{
+	struct co_event ev = {.type = CO_EV_LIFE, .life = {.lost = lost}};
+
+	if (node->ec.life_ind != NULL) {
+		node->ec.life_ind(node, lost, node->ec.life_user_data);
+	}
+	(void)co_node_publish(node, &ev, NULL);
+}
+
 static void life_timeout(struct co_timer *timer, uint64_t now_us)
 {
 	struct co_node *node = timer->user_data;
@@ -262,9 +267,7 @@ static void life_timeout(struct co_timer *timer, uint64_t now_us)
 	node->ec.life_lost = true;
 	LOG_WRN("%s: life guarding event (no guarding request within %u ms)", node->name,
 		node->ec.guard_time_ms * node->ec.life_factor);
-	if (node->ec.life_ind != NULL) {
-		node->ec.life_ind(node, true, node->ec.life_user_data);
-	}
+	life_report(node, true);
 	comm_error(node, 0U, true);
 }
 
@@ -276,7 +279,7 @@ static void life_restart(struct co_node *node, uint64_t now_us)
 		co_timer_stop(&node->ec.life_timer);
 		return;
 	}
-	co_timer_start(node->line, &node->ec.life_timer, now_us + (uint64_t)life_ms * 1000U);
+	co_node_timer_start(node, &node->ec.life_timer, now_us + (uint64_t)life_ms * 1000U);
 }
 
 static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
@@ -284,7 +287,7 @@ static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t n
 	struct co_node *node = rx->user_data;
 
 	if ((frame->flags & CAN_FRAME_RTR) == 0U || node->ec.hb_period_ms != 0U ||
-	    node->nmt.state == CO_NMT_INITIALISING) {
+	    co_node_nmt_state(node) == CO_NMT_INITIALISING) {
 		return;
 	}
 	send_state(node, node->ec.toggle);
@@ -294,9 +297,7 @@ static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t n
 	life_restart(node, now_us);
 	if (node->ec.life_lost) {
 		node->ec.life_lost = false;
-		if (node->ec.life_ind != NULL) {
-			node->ec.life_ind(node, false, node->ec.life_user_data);
-		}
+		life_report(node, false);
 		comm_error(node, 0U, false);
 	}
 }
@@ -315,13 +316,31 @@ static void guard_notify(struct co_od *od, const struct co_od_req *req, void *us
 
 /* --- Node interface ----------------------------------------------------------------------- */
 
-int co_errctl_init(struct co_node *node)
+static int errctl_init(struct co_node *node)
 {
 	struct co_errctl *ec = &node->ec;
 	const struct co_od_hook hooks[] = {
-		{IDX_HB_PRODUCER, IDX_HB_PRODUCER, 0, 0, NULL, hb_producer_notify, node},
-		{IDX_HB_CONSUMER, IDX_HB_CONSUMER, 1, 255, hbc_validate, hbc_notify, node},
-		{IDX_GUARD_TIME, IDX_LIFE_FACTOR, 0, 0, NULL, guard_notify, node},
+		{
+			.index_first = IDX_HB_PRODUCER,
+			.index_last = IDX_HB_PRODUCER,
+			.notify = hb_producer_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_HB_CONSUMER,
+			.index_last = IDX_HB_CONSUMER,
+			.sub_first = 1,
+			.sub_last = 255,
+			.validate = hbc_validate,
+			.notify = hbc_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_GUARD_TIME,
+			.index_last = IDX_LIFE_FACTOR,
+			.notify = guard_notify,
+			.user_data = node,
+		},
 	};
 
 	co_timer_init(&ec->hb_timer, hb_timer_handler, &node->lock, node);
@@ -338,16 +357,16 @@ int co_errctl_init(struct co_node *node)
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
-void co_errctl_reset_comm(struct co_node *node)
+static void errctl_reset_comm(struct co_node *node)
 {
 	struct co_errctl *ec = &node->ec;
-	uint8_t count = (uint8_t)od_uint(node, IDX_HB_CONSUMER, 0);
+	uint8_t count = (uint8_t)co_od_uint(&node->od, IDX_HB_CONSUMER, 0, 0U);
 
 	co_timer_stop(&ec->hb_timer);
 	co_timer_stop(&ec->life_timer);
-	ec->hb_period_ms = (uint16_t)od_uint(node, IDX_HB_PRODUCER, 0);
-	ec->guard_time_ms = (uint16_t)od_uint(node, IDX_GUARD_TIME, 0);
-	ec->life_factor = (uint8_t)od_uint(node, IDX_LIFE_FACTOR, 0);
+	ec->hb_period_ms = (uint16_t)co_od_uint(&node->od, IDX_HB_PRODUCER, 0, 0U);
+	ec->guard_time_ms = (uint16_t)co_od_uint(&node->od, IDX_GUARD_TIME, 0, 0U);
+	ec->life_factor = (uint8_t)co_od_uint(&node->od, IDX_LIFE_FACTOR, 0, 0U);
 	/* The first guarding answer after a reset has the toggle bit 0. */
 	ec->toggle = 0U;
 	ec->guarded = false;
@@ -358,15 +377,19 @@ void co_errctl_reset_comm(struct co_node *node)
 			node->name, count, CONFIG_CANOPEN_HB_CONSUMERS);
 	}
 	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
-		uint32_t v =
-			i < count ? (uint32_t)od_uint(node, IDX_HB_CONSUMER, (uint8_t)(i + 1)) : 0U;
+		uint32_t v = i < count ? (uint32_t)co_od_uint(&node->od, IDX_HB_CONSUMER,
+							      (uint8_t)(i + 1), 0U)
+				       : 0U;
 
 		hbc_configure(node, i, v);
 	}
-	(void)co_rx_set_id(node->line, &ec->guard_rx, CO_NMT_EC_COB_ID + node->node_id);
+	if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &ec->guard_rx,
+			      CO_NMT_EC_COB_ID + node->node_id) != 0) {
+		LOG_ERR("%s: no receive slot for node guarding", node->name);
+	}
 }
 
-void co_errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
+static void errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
 	struct co_errctl *ec = &node->ec;
 
@@ -381,6 +404,13 @@ void co_errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_n
 	/* From Initialising the boot-up message was just sent. */
 	hb_restart(node, from != CO_NMT_INITIALISING);
 }
+
+const struct co_service co_service_errctl = {
+	.name = "errctl",
+	.init = errctl_init,
+	.reset_comm = errctl_reset_comm,
+	.set_state = errctl_set_state,
+};
 
 void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data)
 {

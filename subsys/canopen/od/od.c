@@ -462,6 +462,7 @@ void co_od_reset_comm(struct co_od *od)
 {
 	const struct co_od_def *def = od->def;
 
+	OD_ASSERT_LOCKED(od);
 	memcpy(od->ram, def->ram_defaults, def->comm_end);
 	apply_nodeid(od, 0x0000, 0x1FFF);
 	if (od->restore != NULL) {
@@ -473,6 +474,7 @@ void co_od_reset_app(struct co_od *od)
 {
 	const struct co_od_def *def = od->def;
 
+	OD_ASSERT_LOCKED(od);
 	memcpy(od->ram + def->comm_end, (const uint8_t *)def->ram_defaults + def->comm_end,
 	       def->ram_size - def->comm_end);
 	apply_nodeid(od, 0x2000, 0xFFFF);
@@ -486,12 +488,41 @@ void co_od_reset_app(struct co_od *od)
 /* ---------------------------------------------------------------------------------------- */
 /* Hooks and providers */
 
+/* Remove every hook registered from registration number @p first on (a failed batch). */
+static void hooks_drop_from(struct co_od *od, uint32_t first)
+{
+	uint16_t w = 0;
+
+	od->hook_span = 0;
+	for (uint16_t r = 0; r < od->n_hooks; r++) {
+		if (od->hook_seq[r] >= first) {
+			continue;
+		}
+		od->hooks[w] = od->hooks[r];
+		od->hook_seq[w] = od->hook_seq[r];
+		od->hook_span = MAX(od->hook_span,
+				    (uint16_t)(od->hooks[w].index_last - od->hooks[w].index_first));
+		w++;
+	}
+	od->n_hooks = w;
+	od->hook_gen++;
+}
+
 int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n)
 {
+	uint32_t first;
+
+	if (od == NULL) {
+		return -EINVAL;
+	}
+	OD_ASSERT_LOCKED(od);
+	first = od->hook_next_seq;
 	for (size_t i = 0; i < n; i++) {
 		int err = co_od_hook_register(od, &hooks[i]);
 
 		if (err != 0) {
+			/* All or nothing: a service never runs with half of its hooks. */
+			hooks_drop_from(od, first);
 			return err;
 		}
 	}
@@ -504,6 +535,7 @@ int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 	    hook->sub_last < hook->sub_first || (hook->validate == NULL && hook->notify == NULL)) {
 		return -EINVAL;
 	}
+	OD_ASSERT_LOCKED(od);
 	if (od->n_hooks >= CO_OD_HOOKS_MAX) {
 		return -ENOSPC;
 	}
@@ -532,6 +564,7 @@ int co_od_hook_unregister(struct co_od *od, const void *user_data)
 	uint16_t w = 0;
 	int removed = 0;
 
+	OD_ASSERT_LOCKED(od);
 	od->hook_span = 0;
 	for (uint16_t r = 0; r < od->n_hooks; r++) {
 		if (od->hooks[r].user_data == user_data) {
@@ -880,6 +913,7 @@ uint32_t co_od_read_info(const struct co_od *od, const struct co_od_info *info, 
 {
 	uint32_t ab = check_read(info, reader);
 
+	OD_ASSERT_LOCKED(od);
 	*len = 0;
 	if (ab == 0U) {
 		ab = run_read_check(od, info, reader);
@@ -1034,6 +1068,7 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 {
 	uint32_t ab = check_access(info, writer);
 
+	OD_ASSERT_LOCKED(od);
 	if (ab != 0U) {
 		return ab;
 	}
@@ -1141,6 +1176,7 @@ uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
 			    struct co_od_cover *cover, const void *data, size_t len,
 			    enum co_od_writer writer)
 {
+	OD_ASSERT_LOCKED(od);
 	cover_refresh(od, info, cover);
 	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || len != info->size) {
 		return co_od_write_info(od, info, data, len, writer);
@@ -1185,6 +1221,7 @@ uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info
 			   struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
 			   enum co_od_writer reader)
 {
+	OD_ASSERT_LOCKED(od);
 	cover_refresh(od, info, cover);
 	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || cap < info->size) {
 		return co_od_read_info(od, info, 0, buf, cap, len, reader);
@@ -1243,6 +1280,7 @@ uint32_t co_od_write_begin(struct co_od *od, struct co_od_xfer *x, uint16_t inde
 {
 	uint32_t ab;
 
+	OD_ASSERT_LOCKED(od);
 	/* A transfer restarted without an abort gives its staging buffer back first. */
 	xfer_end(od, x);
 	memset(x, 0, sizeof(*x));
@@ -1282,6 +1320,7 @@ uint32_t co_od_write_chunk(struct co_od *od, struct co_od_xfer *x, uint32_t offs
 {
 	uint32_t ab = 0;
 
+	OD_ASSERT_LOCKED(od);
 	if (!x->active || offset != x->offset) {
 		xfer_end(od, x);
 		return CO_SDO_AB_GENERAL;
@@ -1472,4 +1511,16 @@ uint32_t co_od_set_time(struct co_od *od, uint16_t index, uint8_t sub, const str
 	}
 	co_od_encode_fixed(info.dtype, t, wire);
 	return co_od_write_info(od, &info, wire, 6, writer);
+}
+
+uint32_t co_od_uint(const struct co_od *od, uint16_t index, uint8_t sub, uint32_t dflt)
+{
+	uint8_t wire[8] = {0};
+	size_t len;
+
+	if (co_od_read(od, index, sub, 0, wire, sizeof(wire), &len, CO_OD_WRITER_APP) != 0U ||
+	    len == 0U) {
+		return dflt;
+	}
+	return (uint32_t)co_od_le_get(wire, len);
 }

@@ -10,6 +10,16 @@
 
 #include <canopen/od.h>
 
+#include "lock_check.h"
+
+/* The lock rule: a node's dictionary is used with the node's mutex held (lock_check.h). */
+#define OD_ASSERT_LOCKED(od)                                                                       \
+	do {                                                                                       \
+		if ((od)->lock != NULL) {                                                          \
+			CO_ASSERT_LOCKED((od)->lock);                                              \
+		}                                                                                  \
+	} while (false)
+
 /* Bits of struct co_od_limit.rel. */
 #define CO_OD_LIM_LO_REL   0x01U
 #define CO_OD_LIM_HI_REL   0x02U

@@ -37,6 +37,8 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/cob_id.h>
+#include <canopen/emcy.h>
 #include <canopen/node.h>
 #include <canopen/pdo.h>
 
@@ -60,9 +62,9 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 #define MAP_DAM_MPDO CO_MPDO_DAM
 #define MAP_MAX      64U
 
-#define EMCY_PDO_LENGTH     0x8210U
-#define EMCY_PDO_LENGTH_EXC 0x8220U
-#define EMCY_RPDO_TIMEOUT   0x8250U
+#define EMCY_PDO_LENGTH     CO_EMCY_PDO_LENGTH
+#define EMCY_PDO_LENGTH_EXC CO_EMCY_PDO_LENGTH_EXC
+#define EMCY_RPDO_TIMEOUT   CO_EMCY_RPDO_TIMEOUT
 #define EMCY_DAM_MISSING    0x8230U
 
 #define ERR_SHORT   BIT(0)
@@ -78,17 +80,6 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 
 /* --- Helpers ------------------------------------------------------------------------------ */
 
-static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint64_t dflt)
-{
-	uint8_t buf[8] = {0};
-	size_t len = 0;
-
-	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
-		return dflt;
-	}
-	return co_od_le_get(buf, len);
-}
-
 static bool cob_valid(uint32_t cob)
 {
 	return (cob & CO_PDO_COB_INVALID) == 0U;
@@ -97,14 +88,6 @@ static bool cob_valid(uint32_t cob)
 static uint32_t cob_can_id(uint32_t cob)
 {
 	return (cob & CO_PDO_COB_FRAME) != 0U ? (cob & CAN_ID_EXT) : (cob & CAN_ID_STD);
-}
-
-/* CAN-IDs CiA 301 §7.3.5 reserves for other services. */
-static bool restricted_id(uint32_t id)
-{
-	return id == 0U || id <= 0x07FU || (id >= 0x101U && id <= 0x180U) ||
-	       (id >= 0x581U && id <= 0x5FFU) || (id >= 0x601U && id <= 0x67FU) ||
-	       (id >= 0x6E0U && id <= 0x6FFU) || id >= 0x701U;
 }
 
 static bool is_sync_type(uint8_t type)
@@ -229,7 +212,6 @@ static void rpdo_error(struct co_rpdo *r, uint8_t bit, bool on)
 		return;
 	}
 	r->errors ^= bit;
-#if defined(CONFIG_CANOPEN_EMCY)
 	struct co_node *node = r->node;
 	uint16_t code = bit == ERR_SHORT  ? EMCY_PDO_LENGTH
 			: bit == ERR_LONG ? EMCY_PDO_LENGTH_EXC
@@ -237,7 +219,7 @@ static void rpdo_error(struct co_rpdo *r, uint8_t bit, bool on)
 					  : EMCY_RPDO_TIMEOUT;
 
 	if (on) {
-		co_emcy_raise_internal(node, code, CO_EMCY_REG_COMMUNICATION);
+		co_node_error(node, code, CO_EMCY_REG_COMMUNICATION, 0U, CO_ERROR_F_ACTIVE);
 		return;
 	}
 	/* The code stays active while any other RPDO still has the same fault. */
@@ -246,8 +228,7 @@ static void rpdo_error(struct co_rpdo *r, uint8_t bit, bool on)
 			return;
 		}
 	}
-	co_emcy_clear_internal(node, code);
-#endif
+	co_node_error(node, code, CO_EMCY_REG_COMMUNICATION, 0U, 0U);
 }
 
 /* --- RPDO --------------------------------------------------------------------------------- */
@@ -299,7 +280,7 @@ static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	rpdo_error(r, ERR_SHORT, false);
 	rpdo_error(r, ERR_LONG, frame->dlc > mapped);
 	if (r->event_ms != 0U) {
-		co_timer_start(node->line, &r->timer, now_us + (uint64_t)r->event_ms * 1000U);
+		co_node_timer_start(node, &r->timer, now_us + (uint64_t)r->event_ms * 1000U);
 		rpdo_error(r, ERR_TIMEOUT, false);
 	}
 	if (r->mpdo != 0U) {
@@ -345,7 +326,7 @@ static void rpdo_configure(struct co_rpdo *r)
 	}
 	r->rx.ext = (r->cob_id & CO_PDO_COB_FRAME) != 0U;
 	r->rx.mask = r->rx.ext ? CAN_ID_EXT : CAN_ID_STD;
-	if (co_rx_set_id(node->line, &r->rx, cob_can_id(r->cob_id)) != 0) {
+	if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &r->rx, cob_can_id(r->cob_id)) != 0) {
 		LOG_ERR("%s: no receive slot for RPDO %u", node->name, r->num);
 	}
 }
@@ -374,7 +355,7 @@ static void tpdo_event_timer_restart(struct co_tpdo *t, uint64_t now)
 	co_timer_stop(&t->event_timer);
 	if (t->node->pdo.operational && cob_valid(t->cob_id) && is_event_type(t->type) &&
 	    t->event_ms != 0U && t->mpdo == 0U) {
-		co_timer_start(t->node->line, &t->event_timer, now + (uint64_t)t->event_ms * 1000U);
+		co_node_timer_start(t->node, &t->event_timer, now + (uint64_t)t->event_ms * 1000U);
 	}
 }
 
@@ -388,7 +369,7 @@ static void tpdo_transmit(struct co_tpdo *t, uint64_t now)
 	};
 
 	memcpy(f.data, t->buf, sizeof(t->buf));
-	(void)co_node_send(t->node, &f);
+	(void)co_node_send(t->node, CO_ROUTE_DEFAULT, &f);
 	t->deferred = false;
 	t->inhibit_end = now + t->inhibit_us;
 	if (is_event_type(t->type)) {
@@ -399,7 +380,7 @@ static void tpdo_transmit(struct co_tpdo *t, uint64_t now)
 static void tpdo_defer(struct co_tpdo *t)
 {
 	if (!co_timer_is_armed(&t->inhibit_timer)) {
-		co_timer_start(t->node->line, &t->inhibit_timer, t->inhibit_end);
+		co_node_timer_start(t->node, &t->inhibit_timer, t->inhibit_end);
 	}
 }
 
@@ -447,7 +428,7 @@ int co_tpdo_mpdo_send(struct co_tpdo *t, const uint8_t data[8])
 	}
 	memcpy(t->buf, data, sizeof(t->buf));
 	t->dlc = 8U;
-	tpdo_send_sample(t, co_line_time(t->node->line));
+	tpdo_send_sample(t, co_node_time(t->node));
 	return 0;
 }
 
@@ -514,7 +495,7 @@ static void tpdo_reset_state(struct co_tpdo *t)
 	t->event = false;
 	t->deferred = false;
 	t->sampled = false;
-	t->inhibit_end = co_line_time(t->node->line);
+	t->inhibit_end = co_node_time(t->node);
 }
 
 static void tpdo_configure(struct co_tpdo *t)
@@ -529,11 +510,11 @@ static void tpdo_configure(struct co_tpdo *t)
 	if (IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) && (t->cob_id & CO_PDO_COB_NO_RTR) == 0U) {
 		t->rx.ext = (t->cob_id & CO_PDO_COB_FRAME) != 0U;
 		t->rx.mask = t->rx.ext ? CAN_ID_EXT : CAN_ID_STD;
-		if (co_rx_set_id(node->line, &t->rx, cob_can_id(t->cob_id)) != 0) {
+		if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &t->rx, cob_can_id(t->cob_id)) != 0) {
 			LOG_ERR("%s: no receive slot for TPDO %u RTR", node->name, t->num);
 		}
 	}
-	tpdo_event_timer_restart(t, co_line_time(node->line));
+	tpdo_event_timer_restart(t, co_node_time(node));
 }
 
 /* --- Change of state ---------------------------------------------------------------------- */
@@ -546,7 +527,7 @@ static void cos_notify(struct co_od *od, const struct co_od_req *req, void *user
 	    !cob_valid(t->cob_id)) {
 		return;
 	}
-	tpdo_event(t, co_line_time(t->node->line));
+	tpdo_event(t, co_node_time(t->node));
 }
 
 /* Hooks a mapping needs: one per run of consecutive sub-indexes of one object. */
@@ -634,7 +615,8 @@ static void tpdo_sync(struct co_tpdo *t, uint8_t counter, uint64_t now)
 	}
 }
 
-void co_pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uint32_t window_us)
+/* A SYNC: synchronous TPDOs sampled and sent, synchronous RPDOs committed (CiA 301 §7.2.2.2). */
+static void pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uint32_t window_us)
 {
 	struct co_pdo *pdo = &node->pdo;
 
@@ -663,6 +645,13 @@ void co_pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uint32_
 	}
 }
 
+static int sync_event(struct co_node *node, const struct co_event *ev, void *user_data)
+{
+	ARG_UNUSED(user_data);
+	pdo_sync(node, ev->sync.counter, ev->sync.time_us, ev->sync.window_us);
+	return 0;
+}
+
 /* --- Hooks on 1400h-1BFFh ----------------------------------------------------------------- */
 
 static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
@@ -683,7 +672,7 @@ static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
-		    restricted_id((uint32_t)v & CAN_ID_STD)) {
+		    co_cob_id_restricted((uint32_t)v & CAN_ID_STD)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		return 0U;
@@ -722,8 +711,8 @@ static void rpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void
 			co_timer_stop(&r->timer);
 			rpdo_error(r, ERR_TIMEOUT, false);
 		} else if (co_timer_is_armed(&r->timer)) {
-			co_timer_start(r->node->line, &r->timer,
-				       co_line_time(r->node->line) + (uint64_t)r->event_ms * 1000U);
+			co_node_timer_start(r->node, &r->timer,
+					    co_node_time(r->node) + (uint64_t)r->event_ms * 1000U);
 		}
 		break;
 	default:
@@ -752,7 +741,7 @@ static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
-		    restricted_id((uint32_t)v & CAN_ID_STD)) {
+		    co_cob_id_restricted((uint32_t)v & CAN_ID_STD)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		/* An RTR-only TPDO needs remote requests. */
@@ -813,7 +802,7 @@ static void tpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void
 		break;
 	case SUB_EVENT:
 		t->event_ms = (uint16_t)v;
-		tpdo_event_timer_restart(t, co_line_time(t->node->line));
+		tpdo_event_timer_restart(t, co_node_time(t->node));
 		break;
 	case SUB_SYNC_START:
 		t->sync_start = (uint8_t)v;
@@ -847,7 +836,7 @@ static uint32_t map_validate(struct co_od *od, struct co_od_req *req, void *user
 		struct co_pdo_map_ent ent;
 
 		/* Entries change only while the mapping is off (sub 0 = 0). */
-		if (od_uint(node, index, 0, 0U) != 0U) {
+		if (co_od_uint(&node->od, index, 0, 0U) != 0U) {
 			return AB_PDO_STATE;
 		}
 		return v == 0U ? 0U : co_pdo_map_check(&node->od, rx, (uint32_t)v, &ent);
@@ -912,7 +901,7 @@ static bool od_has(struct co_node *node, uint16_t index)
 	return co_od_find(&node->od, index, 0, &info) == 0U;
 }
 
-int co_pdo_init(struct co_node *node)
+static int pdo_init(struct co_node *node)
 {
 	struct co_pdo *pdo = &node->pdo;
 	int err = 0;
@@ -955,20 +944,48 @@ int co_pdo_init(struct co_node *node)
 	}
 	if (CO_RPDOS > 0) {
 		const struct co_od_hook hooks[] = {
-			{IDX_RPDO_COMM, IDX_RPDO_COMM + CO_RPDOS - 1, 1, 6, rpdo_comm_validate,
-			 rpdo_comm_notify, node},
-			{IDX_RPDO_MAP, IDX_RPDO_MAP + CO_RPDOS - 1, 0, MAP_MAX, map_validate,
-			 map_notify, node},
+			{
+				.index_first = IDX_RPDO_COMM,
+				.index_last = IDX_RPDO_COMM + CO_RPDOS - 1,
+				.sub_first = 1,
+				.sub_last = 6,
+				.validate = rpdo_comm_validate,
+				.notify = rpdo_comm_notify,
+				.user_data = node,
+			},
+			{
+				.index_first = IDX_RPDO_MAP,
+				.index_last = IDX_RPDO_MAP + CO_RPDOS - 1,
+				.sub_first = 0,
+				.sub_last = MAP_MAX,
+				.validate = map_validate,
+				.notify = map_notify,
+				.user_data = node,
+			},
 		};
 
 		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 	}
 	if (err == 0 && CO_TPDOS > 0) {
 		const struct co_od_hook hooks[] = {
-			{IDX_TPDO_COMM, IDX_TPDO_COMM + CO_TPDOS - 1, 1, 6, tpdo_comm_validate,
-			 tpdo_comm_notify, node},
-			{IDX_TPDO_MAP, IDX_TPDO_MAP + CO_TPDOS - 1, 0, MAP_MAX, map_validate,
-			 map_notify, node},
+			{
+				.index_first = IDX_TPDO_COMM,
+				.index_last = IDX_TPDO_COMM + CO_TPDOS - 1,
+				.sub_first = 1,
+				.sub_last = 6,
+				.validate = tpdo_comm_validate,
+				.notify = tpdo_comm_notify,
+				.user_data = node,
+			},
+			{
+				.index_first = IDX_TPDO_MAP,
+				.index_last = IDX_TPDO_MAP + CO_TPDOS - 1,
+				.sub_first = 0,
+				.sub_last = MAP_MAX,
+				.validate = map_validate,
+				.notify = map_notify,
+				.user_data = node,
+			},
 		};
 
 		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
@@ -978,6 +995,11 @@ int co_pdo_init(struct co_node *node)
 		err = co_mpdo_init(node);
 	}
 #endif
+	if (err == 0) {
+		co_listener_init(&pdo->sync_listener, "pdo", CO_EV_BIT(CO_EV_SYNC), sync_event,
+				 NULL);
+		err = co_node_listener_add(node, &pdo->sync_listener);
+	}
 	return err;
 }
 
@@ -985,7 +1007,7 @@ static uint8_t map_load(struct co_node *node, bool rx, uint16_t num, uint8_t typ
 			struct co_pdo_map *map, uint8_t *mpdo)
 {
 	uint16_t index = (rx ? IDX_RPDO_MAP : IDX_TPDO_MAP) + num;
-	uint8_t n = (uint8_t)od_uint(node, index, 0, 0U);
+	uint8_t n = (uint8_t)co_od_uint(&node->od, index, 0, 0U);
 	uint8_t runs;
 
 	*mpdo = 0U;
@@ -1000,7 +1022,7 @@ static uint8_t map_load(struct co_node *node, bool rx, uint16_t num, uint8_t typ
 	return 0U;
 }
 
-void co_pdo_reset_comm(struct co_node *node)
+static void pdo_reset_comm(struct co_node *node)
 {
 	struct co_pdo *pdo = &node->pdo;
 
@@ -1012,9 +1034,9 @@ void co_pdo_reset_comm(struct co_node *node)
 		if (!r->present) {
 			continue;
 		}
-		r->cob_id = (uint32_t)od_uint(node, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
-		r->type = (uint8_t)od_uint(node, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
-		r->event_ms = (uint16_t)od_uint(node, comm, SUB_EVENT, 0U);
+		r->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
+		r->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		r->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
 		if (map_load(node, true, i, r->type, &r->map, &r->mpdo) != 0U) {
 			r->cob_id |= CO_PDO_COB_INVALID;
 		}
@@ -1027,11 +1049,11 @@ void co_pdo_reset_comm(struct co_node *node)
 		if (!t->present) {
 			continue;
 		}
-		t->cob_id = (uint32_t)od_uint(node, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
-		t->type = (uint8_t)od_uint(node, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
-		t->inhibit_us = (uint32_t)od_uint(node, comm, SUB_INHIBIT, 0U) * 100U;
-		t->event_ms = (uint16_t)od_uint(node, comm, SUB_EVENT, 0U);
-		t->sync_start = (uint8_t)od_uint(node, comm, SUB_SYNC_START, 0U);
+		t->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
+		t->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		t->inhibit_us = (uint32_t)co_od_uint(&node->od, comm, SUB_INHIBIT, 0U) * 100U;
+		t->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
+		t->sync_start = (uint8_t)co_od_uint(&node->od, comm, SUB_SYNC_START, 0U);
 		if (map_load(node, false, i, t->type, &t->map, &t->mpdo) != 0U) {
 			t->cob_id |= CO_PDO_COB_INVALID;
 		}
@@ -1040,8 +1062,10 @@ void co_pdo_reset_comm(struct co_node *node)
 	}
 }
 
-void co_pdo_set_state(struct co_node *node, enum co_nmt_state to)
+static void pdo_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
+	ARG_UNUSED(from);
+
 	struct co_pdo *pdo = &node->pdo;
 	bool op = to == CO_NMT_OPERATIONAL;
 
@@ -1060,10 +1084,17 @@ void co_pdo_set_state(struct co_node *node, enum co_nmt_state to)
 
 		if (t->present) {
 			tpdo_reset_state(t);
-			tpdo_event_timer_restart(t, co_line_time(node->line));
+			tpdo_event_timer_restart(t, co_node_time(node));
 		}
 	}
 }
+
+const struct co_service co_service_pdo = {
+	.name = "pdo",
+	.init = pdo_init,
+	.reset_comm = pdo_reset_comm,
+	.set_state = pdo_set_state,
+};
 
 /* --- API ---------------------------------------------------------------------------------- */
 
@@ -1084,7 +1115,7 @@ int co_tpdo_send_req(struct co_node *node, uint16_t num)
 	} else if (!uses_events(t->type) || t->mpdo != 0U) {
 		err = -ENOTSUP;
 	} else {
-		tpdo_event(t, co_line_time(node->line));
+		tpdo_event(t, co_node_time(node));
 	}
 	co_node_unlock(node);
 	return err;

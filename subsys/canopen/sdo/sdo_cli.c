@@ -14,7 +14,9 @@
  * The confirmation runs in the line thread. Events that happen in an application thread (an
  * abort request, an NMT change or a reconfiguration made by the application) do not call it
  * there: they park the result (ST_CONFIRM) and arm the timer for "now", and the line thread
- * delivers it. The decisions are listed in doc/sdo-client.md.
+ * delivers it. The blocking calls wait for the confirmation on a semaphore; when their own
+ * timeout expires they abort and confirm in place (sync_wait()). The decisions are listed in
+ * doc/sdo-client.md.
  */
 
 #include <errno.h>
@@ -29,6 +31,7 @@
 #include <canopen/sdo.h>
 #include <canopen/sdo_cli.h>
 
+#include "node_internal.h"
 #include "sdo_internal.h"
 
 LOG_MODULE_REGISTER(co_sdo_cli, CONFIG_CANOPEN_LOG_LEVEL);
@@ -89,7 +92,7 @@ static bool running(const struct co_sdo_cli *cli)
 
 static uint64_t cli_now(const struct co_sdo_cli *cli)
 {
-	return co_line_time(co_node_line(cli->node));
+	return co_node_time(cli->node);
 }
 
 static void put_mux(uint8_t *d, uint16_t index, uint8_t sub)
@@ -116,7 +119,7 @@ static int cli_send(struct co_sdo_cli *cli, const uint8_t d[CO_SDO_DLC])
 	}
 	f.dlc = CO_SDO_DLC;
 	memcpy(f.data, d, CO_SDO_DLC);
-	return co_node_send(cli->node, &f);
+	return co_node_send(cli->node, CO_ROUTE_ACTIVE, &f);
 }
 
 /* Arm the timer for the earliest deadline of the transfer. */
@@ -128,7 +131,7 @@ static void cli_arm(struct co_sdo_cli *cli)
 	    co_time_before_eq(cli->retry_at, t)) {
 		t = cli->retry_at;
 	}
-	co_timer_start(co_node_line(cli->node), &cli->timer, t);
+	co_node_timer_start(cli->node, &cli->timer, t);
 }
 
 static void cli_wait(struct co_sdo_cli *cli, uint64_t now)
@@ -147,7 +150,10 @@ static size_t cli_done_size(const struct co_sdo_cli *cli, uint32_t code)
 	return cli->offset;
 }
 
-/* End the transfer and confirm it (line thread only). */
+/*
+ * End the transfer and confirm it: in the line thread, or for a blocking call's own
+ * confirmation (sync_wait()), which only records the result.
+ */
 static void cli_finish(struct co_sdo_cli *cli, uint32_t code)
 {
 	co_sdo_cli_con_t con = cli->con;
@@ -173,7 +179,7 @@ static void cli_finish_later(struct co_sdo_cli *cli, uint32_t code)
 {
 	cli->result = code;
 	cli->state = ST_CONFIRM;
-	co_timer_start(co_node_line(cli->node), &cli->timer, cli_now(cli));
+	co_node_timer_start(cli->node, &cli->timer, cli_now(cli));
 }
 
 static void cli_send_abort(struct co_sdo_cli *cli, uint32_t code)
@@ -286,7 +292,8 @@ static void blk_dn_send(struct co_sdo_cli *cli, uint64_t now)
 		if (chunk > 0U) {
 			memcpy(&d[1], &cli->dn_data[o], chunk);
 		}
-		err = co_line_tx_space(co_node_line(cli->node)) > 0 ? cli_send(cli, d) : -ENOBUFS;
+		err = co_node_tx_space(cli->node, CO_ROUTE_ACTIVE) > 0 ? cli_send(cli, d)
+								       : -ENOBUFS;
 		if (err == -ENOBUFS) {
 			cli->stats.tx_retries++;
 			cli->retry_at = now + TX_RETRY_US;
@@ -636,7 +643,8 @@ static void cli_timer(struct co_timer *timer, uint64_t now_us)
 		/* The server cannot answer frames that still wait in our TX queue (see the
 		 * server): put the timeout off, a bounded number of times.
 		 */
-		if (co_line_tx_space(co_node_line(cli->node)) < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE &&
+		if (co_node_tx_space(cli->node, CO_ROUTE_ACTIVE) <
+			    CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE &&
 		    cli->tx_waits < TX_WAITS_MAX) {
 			cli->tx_waits++;
 			cli->deadline = now_us + cli->timeout_us;
@@ -687,7 +695,7 @@ static void cli_bind(struct co_sdo_cli *cli)
 	cli->rx.ext = ext;
 	cli->rx.mask = ext ? EFF_MASK : SFF_MASK;
 	cli->rx.id = cli->cob_rx & cli->rx.mask;
-	err = co_rx_register(co_node_line(cli->node), &cli->rx);
+	err = co_node_rx_register(cli->node, CO_LINE_DEFAULT, &cli->rx);
 	if (err != 0) {
 		LOG_ERR("SDO client %u: cannot receive COB-ID %x (%d)", cli->num, cli->rx.id, err);
 		cli->cob_rx |= CO_SDO_COBID_INVALID;
@@ -823,6 +831,42 @@ void co_sdo_cli_set_state(struct co_sdo_cli *cli, enum co_nmt_state to)
 		cli_drop(cli);
 	}
 }
+
+/* The node's clients as one service (canopen/services.h). */
+static int cli_service_init(struct co_node *node)
+{
+	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		int err = co_sdo_cli_init(&node->sdo_cli[i], node, i);
+
+		if (err != 0) {
+			return err;
+		}
+	}
+	return 0;
+}
+
+static void cli_service_reset_comm(struct co_node *node)
+{
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		co_sdo_cli_reset_comm(&node->sdo_cli[i]);
+	}
+}
+
+static void cli_service_set_state(struct co_node *node, enum co_nmt_state from,
+				  enum co_nmt_state to)
+{
+	ARG_UNUSED(from);
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_CLIENTS; i++) {
+		co_sdo_cli_set_state(&node->sdo_cli[i], to);
+	}
+}
+
+const struct co_service co_service_sdo_cli = {
+	.name = "sdo_cli",
+	.init = cli_service_init,
+	.reset_comm = cli_service_reset_comm,
+	.set_state = cli_service_set_state,
+};
 
 /* --- API --------------------------------------------------------------------------------- */
 
@@ -1035,13 +1079,14 @@ void co_sdo_cli_get_stats(struct co_sdo_cli *cli, struct co_sdo_cli_stats *stats
 
 /* --- Blocking calls ---------------------------------------------------------------------- */
 
-/* One blocking call: lives on the caller's stack until the confirmation. */
+/* One blocking call: lives on the caller's stack until the call returns. */
 struct sync_call {
 	struct k_sem sem;
 	uint32_t code;
 	size_t size;
 };
 
+/* Runs with the node's mutex held: in the line thread, or in sync_wait() after a timeout. */
 static void sync_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, void *user_data)
 {
 	struct sync_call *call = user_data;
@@ -1053,75 +1098,114 @@ static void sync_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, v
 }
 
 /*
- * Waiting in the line thread, or with the node's mutex held, would stop the very thread that
- * delivers the confirmation.
+ * The confirmation comes from the line thread of the client's node, which takes the mutex of
+ * every node on its line around their dispatches. Waiting in any line thread (this one, or
+ * one whose nodes the others depend on) or with one of those mutexes held could stop it for
+ * good. Checked before the client takes its own node's mutex, so that mutex counts only when
+ * the caller holds it.
  */
 static bool would_deadlock(struct co_sdo_cli *cli)
 {
-	struct co_node *node = cli->node;
-	k_tid_t line_tid = co_node_line(node)->tid;
-	bool held;
+	struct co_line *line = co_node_line(cli->node);
 
-	if (line_tid != NULL && k_current_get() == line_tid) {
+	/* The second test covers the client's own line without CONFIG_THREAD_CUSTOM_DATA. */
+	if (co_line_current() != NULL || k_current_get() == &line->thread) {
 		return true;
 	}
-	co_node_lock(node);
-	/* Our own lock counts once; more means the caller held it already. */
-	held = node->lock.lock_count > 1U;
-	co_node_unlock(node);
-	return held;
+	return co_line_owner_held(line);
+}
+
+static int sync_check(struct co_sdo_cli *cli, k_timeout_t timeout, uint32_t *abort_code)
+{
+	if (abort_code != NULL) {
+		*abort_code = CO_SDO_AB_NONE;
+	}
+	if (cli == NULL || abort_code == NULL || K_TIMEOUT_EQ(timeout, K_NO_WAIT)) {
+		return -EINVAL;
+	}
+	return would_deadlock(cli) ? -EDEADLK : 0;
+}
+
+/*
+ * Wait for the confirmation of the transfer started with @p call. When @p timeout expires
+ * first, abort the transfer and confirm it here, under the node's mutex (sync_con only records
+ * and wakes): the call returns at once and the client is idle, without waiting for the line
+ * thread. The mutex orders this against the line thread: either it has confirmed already (the
+ * transfer no longer carries @p call) or it cannot until we are done.
+ */
+static int sync_wait(struct co_sdo_cli *cli, struct sync_call *call, k_timeout_t timeout,
+		     uint32_t *abort_code)
+{
+	bool expired = false;
+
+	if (k_sem_take(&call->sem, timeout) != 0) {
+		co_node_lock(cli->node);
+		if (cli->state != ST_IDLE && cli->con == sync_con && cli->user_data == call) {
+			uint32_t code = cli->result;
+
+			if (running(cli)) {
+				cli_send_abort(cli, CO_SDO_AB_TIMEOUT);
+				code = CO_SDO_AB_TIMEOUT;
+				expired = true;
+			}
+			/* Otherwise it ended meanwhile (ST_CONFIRM): report its own result. */
+			cli_finish(cli, code);
+		}
+		co_node_unlock(cli->node);
+		/* Confirmed by now, by the line thread or just above. */
+		(void)k_sem_take(&call->sem, K_NO_WAIT);
+	}
+	if (expired) {
+		return -EAGAIN;
+	}
+	if (call->code != CO_SDO_AB_NONE) {
+		*abort_code = call->code;
+		return -ECONNABORTED;
+	}
+	return 0;
 }
 
 int co_sdo_cli_download(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, const void *data,
-			size_t len, enum co_sdo_cli_mode mode, uint32_t timeout_ms,
+			size_t len, enum co_sdo_cli_mode mode, k_timeout_t timeout,
 			uint32_t *abort_code)
 {
-	struct sync_call call;
-	int err;
+	struct sync_call call = {0};
+	int err = sync_check(cli, timeout, abort_code);
 
-	if (cli == NULL) {
-		return -EINVAL;
-	}
-	if (would_deadlock(cli)) {
-		return -EDEADLK;
-	}
-	k_sem_init(&call.sem, 0, 1);
-	err = co_sdo_cli_download_req(cli, index, sub, data, len, mode, timeout_ms, sync_con,
-				      &call);
 	if (err != 0) {
 		return err;
 	}
-	(void)k_sem_take(&call.sem, K_FOREVER);
-	if (abort_code != NULL) {
-		*abort_code = call.code;
+	k_sem_init(&call.sem, 0, 1);
+	/* Protocol timeout 0: CONFIG_CANOPEN_SDO_CLIENT_TIMEOUT per answer of the server. */
+	err = co_sdo_cli_download_req(cli, index, sub, data, len, mode, 0U, sync_con, &call);
+	if (err != 0) {
+		return err;
 	}
-	return 0;
+	return sync_wait(cli, &call, timeout, abort_code);
 }
 
 int co_sdo_cli_upload(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, void *buf, size_t cap,
-		      size_t *len, enum co_sdo_cli_mode mode, uint32_t timeout_ms,
+		      size_t *len, enum co_sdo_cli_mode mode, k_timeout_t timeout,
 		      uint32_t *abort_code)
 {
-	struct sync_call call;
+	struct sync_call call = {0};
 	int err;
 
-	if (cli == NULL) {
-		return -EINVAL;
+	if (len != NULL) {
+		*len = 0U;
 	}
-	if (would_deadlock(cli)) {
-		return -EDEADLK;
-	}
-	k_sem_init(&call.sem, 0, 1);
-	err = co_sdo_cli_upload_req(cli, index, sub, buf, cap, mode, timeout_ms, sync_con, &call);
+	err = sync_check(cli, timeout, abort_code);
 	if (err != 0) {
 		return err;
 	}
-	(void)k_sem_take(&call.sem, K_FOREVER);
+	k_sem_init(&call.sem, 0, 1);
+	err = co_sdo_cli_upload_req(cli, index, sub, buf, cap, mode, 0U, sync_con, &call);
+	if (err != 0) {
+		return err;
+	}
+	err = sync_wait(cli, &call, timeout, abort_code);
 	if (len != NULL) {
 		*len = call.size;
 	}
-	if (abort_code != NULL) {
-		*abort_code = call.code;
-	}
-	return 0;
+	return err;
 }

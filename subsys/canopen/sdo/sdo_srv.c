@@ -32,6 +32,7 @@
 #include <canopen/node.h>
 #include <canopen/sdo.h>
 
+#include "node_internal.h"
 #include "sdo_internal.h"
 
 LOG_MODULE_REGISTER(co_sdo_srv, CONFIG_CANOPEN_LOG_LEVEL);
@@ -99,7 +100,7 @@ static int srv_send(struct co_sdo_srv *srv, const uint8_t d[CO_SDO_DLC])
 	}
 	f.dlc = CO_SDO_DLC;
 	memcpy(f.data, d, CO_SDO_DLC);
-	return co_node_send(srv->node, &f);
+	return co_node_send(srv->node, srv->route, &f);
 }
 
 /* Send a frame made of byte 0, the transfer's multiplexer and zeros. */
@@ -172,7 +173,7 @@ static void srv_arm(struct co_sdo_srv *srv)
 		t = srv->sub_deadline;
 	}
 #endif
-	co_timer_start(co_node_line(srv->node), &srv->timer, t);
+	co_node_timer_start(srv->node, &srv->timer, t);
 }
 
 /* --- Download ---------------------------------------------------------------------------- */
@@ -596,7 +597,7 @@ static uint32_t blk_up_send(struct co_sdo_srv *srv, uint64_t now)
 		r[0] = i | (last ? CO_SDO_BLK_SEG_C : 0U);
 		memcpy(&r[1], &srv->buf[o - srv->buf_off], len);
 		/* Pause before the line's TX queue overflows rather than lose a frame to it. */
-		err = co_line_tx_space(srv->node->line) > 0 ? srv_send(srv, r) : -ENOBUFS;
+		err = co_node_tx_space(srv->node, srv->route) > 0 ? srv_send(srv, r) : -ENOBUFS;
 		if (err == -ENOBUFS) {
 			/* The line's TX queue is full: offer the rest again shortly. */
 			srv->stats.tx_retries++;
@@ -810,6 +811,8 @@ static void srv_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		srv->stats.rx_inactive++;
 		return;
 	}
+	/* Answers go back on the line the request came on. */
+	srv->route = co_node_route_of(srv->node, rx);
 	srv->in_rx = true;
 	code = srv_dispatch(srv, frame->data, now_us);
 	if (code != CO_SDO_AB_NONE) {
@@ -840,7 +843,7 @@ static void srv_timer(struct co_timer *timer, uint64_t now_us)
 		 * sub-block behind a slow controller): the timeout runs from when they can have
 		 * left. Bounded, so a queue that never drains still ends the transfer.
 		 */
-		if (co_line_tx_space(srv->node->line) < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE &&
+		if (co_node_tx_space(srv->node, srv->route) < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE &&
 		    srv->tx_waits < TX_WAITS_MAX) {
 			srv->tx_waits++;
 			srv->deadline = now_us + TIMEOUT_US;
@@ -920,7 +923,7 @@ static void srv_configure(struct co_sdo_srv *srv)
 	srv->rx.ext = ext;
 	srv->rx.mask = ext ? EFF_MASK : SFF_MASK;
 	srv->rx.id = rx & srv->rx.mask;
-	err = co_rx_register(co_node_line(srv->node), &srv->rx);
+	err = co_node_rx_register(srv->node, CO_LINE_DEFAULT, &srv->rx);
 	if (err != 0) {
 		LOG_ERR("SDO server %u: cannot receive COB-ID %x (%d)", srv->num, srv->rx.id, err);
 	}
@@ -1005,6 +1008,7 @@ int co_sdo_srv_init(struct co_sdo_srv *srv, struct co_node *node, uint8_t num)
 	srv->num = num;
 	srv->cob_rx = CO_SDO_COBID_INVALID;
 	srv->cob_tx = CO_SDO_COBID_INVALID;
+	srv->route = CO_ROUTE_DEFAULT;
 	srv->rx.handler = srv_rx;
 	srv->rx.lock = &node->lock;
 	srv->rx.user_data = srv;
@@ -1042,6 +1046,42 @@ void co_sdo_srv_set_state(struct co_sdo_srv *srv, enum co_nmt_state state)
 		srv_drop(srv);
 	}
 }
+
+/* The node's servers as one service (canopen/services.h). */
+static int srv_service_init(struct co_node *node)
+{
+	for (uint8_t i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
+		int err = co_sdo_srv_init(&node->sdo_srv[i], node, i);
+
+		if (err != 0) {
+			return err;
+		}
+	}
+	return 0;
+}
+
+static void srv_service_reset_comm(struct co_node *node)
+{
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
+		co_sdo_srv_reset_comm(&node->sdo_srv[i]);
+	}
+}
+
+static void srv_service_set_state(struct co_node *node, enum co_nmt_state from,
+				  enum co_nmt_state to)
+{
+	ARG_UNUSED(from);
+	for (int i = 0; i < CONFIG_CANOPEN_SDO_SERVERS; i++) {
+		co_sdo_srv_set_state(&node->sdo_srv[i], to);
+	}
+}
+
+const struct co_service co_service_sdo_srv = {
+	.name = "sdo_srv",
+	.init = srv_service_init,
+	.reset_comm = srv_service_reset_comm,
+	.set_state = srv_service_set_state,
+};
 
 struct co_sdo_srv *co_sdo_srv_get(struct co_node *node, uint8_t num)
 {

@@ -23,6 +23,8 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/cob_id.h>
+#include <canopen/emcy.h>
 #include <canopen/node.h>
 #include <canopen/sync.h>
 
@@ -38,30 +40,22 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 #define COB_GEN BIT(30)
 #define COB_EXT BIT(29)
 
-#define SYNC_LENGTH_ERROR 0x8240U
-
-static uint64_t od_uint(struct co_node *node, uint16_t index, uint8_t sub, uint64_t dflt)
-{
-	uint8_t buf[8] = {0};
-	size_t len = 0;
-
-	if (co_od_read(&node->od, index, sub, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) != 0) {
-		return dflt;
-	}
-	return co_od_le_get(buf, len);
-}
-
-/* One SYNC: the application, then the synchronous PDOs, then the application again. */
+/*
+ * One SYNC: the application, then the SYNC event (the synchronous PDOs and every other
+ * listener), then the application again.
+ */
 static void indicate(struct co_node *node, uint8_t counter, uint64_t now_us)
 {
 	struct co_sync *s = &node->sync;
+	struct co_event ev = {
+		.type = CO_EV_SYNC,
+		.sync = {.counter = counter, .window_us = s->window_us, .time_us = now_us},
+	};
 
 	if (s->ind != NULL) {
 		s->ind(node, counter, s->ind_user_data);
 	}
-#if defined(CONFIG_CANOPEN_PDO)
-	co_pdo_sync(node, counter, now_us, s->window_us);
-#endif
+	(void)co_node_publish(node, &ev, NULL);
 	if (s->post_ind != NULL) {
 		s->post_ind(node, counter, s->post_ind_user_data);
 	}
@@ -86,7 +80,7 @@ static void send_sync(struct co_node *node, uint64_t now_us)
 		f.data[0] = counter;
 		s->counter = counter >= s->overflow ? 1U : (uint8_t)(counter + 1U);
 	}
-	(void)co_node_send(node, &f);
+	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
 	indicate(node, counter, now_us);
 }
 
@@ -104,7 +98,7 @@ static void timer_handler(struct co_timer *timer, uint64_t now_us)
 	if (co_time_before_eq(next, now_us)) {
 		next = now_us + s->period_us;
 	}
-	co_timer_start(node->line, timer, next);
+	co_node_timer_start(node, timer, next);
 }
 
 static void producer_restart(struct co_node *node)
@@ -114,7 +108,7 @@ static void producer_restart(struct co_node *node)
 	co_timer_stop(&s->timer);
 	s->counter = 1U;
 	if (producing(s)) {
-		co_timer_start(node->line, &s->timer, co_line_time(node->line) + s->period_us);
+		co_node_timer_start(node, &s->timer, co_node_time(node) + s->period_us);
 	}
 }
 
@@ -130,14 +124,11 @@ static void sync_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 		return;
 	}
 	if (frame->dlc != want) {
-#if defined(CONFIG_CANOPEN_EMCY)
-		co_emcy_raise_internal(node, SYNC_LENGTH_ERROR, CO_EMCY_REG_COMMUNICATION);
-#endif
+		co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U,
+			      CO_ERROR_F_ACTIVE);
 		return;
 	}
-#if defined(CONFIG_CANOPEN_EMCY)
-	co_emcy_clear_internal(node, SYNC_LENGTH_ERROR);
-#endif
+	co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U, 0U);
 	indicate(node, want != 0U ? frame->data[0] : 0U, now_us);
 }
 
@@ -150,7 +141,7 @@ static void rx_configure(struct co_node *node)
 		co_rx_unregister(&s->rx);
 		return;
 	}
-	if (co_rx_set_id(node->line, &s->rx, s->cob_id & 0x7ffU) != 0) {
+	if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &s->rx, s->cob_id & 0x7ffU) != 0) {
 		LOG_ERR("%s: no receive slot for SYNC", node->name);
 	}
 }
@@ -168,6 +159,10 @@ static uint32_t cob_validate(struct co_od *od, struct co_od_req *req, void *user
 	}
 	/* Only 11-bit SYNC is served; bit 31 is "don't care" for SYNC. */
 	if ((v & COB_EXT) != 0U || (v & 0x1ffff800U) != 0U) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	/* CiA 301 §7.3.5: not on another service's identifier (000h would be NMT). */
+	if (co_cob_id_restricted(v & 0x7ffU)) {
 		return CO_SDO_AB_INVALID_VALUE;
 	}
 	/* A producer keeps its CAN-ID (CiA 301 §7.5.2.5). */
@@ -211,7 +206,7 @@ static uint32_t overflow_validate(struct co_od *od, struct co_od_req *req, void 
 		return 0U;
 	}
 	/* CiA 301 §7.5.2.20: only while no SYNC is produced; 0 or 2..240. */
-	if (od_uint(node, IDX_PERIOD, 0, 0U) != 0U) {
+	if (co_od_uint(&node->od, IDX_PERIOD, 0, 0U) != 0U) {
 		return CO_SDO_AB_DATA_DEV_STATE;
 	}
 	if (v == 1U || v > 240U) {
@@ -230,14 +225,36 @@ static void overflow_notify(struct co_od *od, const struct co_od_req *req, void 
 
 /* --- Node interface ----------------------------------------------------------------------- */
 
-int co_sync_init(struct co_node *node)
+static int sync_init(struct co_node *node)
 {
 	struct co_sync *s = &node->sync;
 	const struct co_od_hook hooks[] = {
-		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
-		{IDX_PERIOD, IDX_PERIOD, 0, 0, NULL, period_notify, node},
-		{IDX_WINDOW, IDX_WINDOW, 0, 0, NULL, window_notify, node},
-		{IDX_OVERFLOW, IDX_OVERFLOW, 0, 0, overflow_validate, overflow_notify, node},
+		{
+			.index_first = IDX_COB_ID,
+			.index_last = IDX_COB_ID,
+			.validate = cob_validate,
+			.notify = cob_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_PERIOD,
+			.index_last = IDX_PERIOD,
+			.notify = period_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_WINDOW,
+			.index_last = IDX_WINDOW,
+			.notify = window_notify,
+			.user_data = node,
+		},
+		{
+			.index_first = IDX_OVERFLOW,
+			.index_last = IDX_OVERFLOW,
+			.validate = overflow_validate,
+			.notify = overflow_notify,
+			.user_data = node,
+		},
 	};
 
 	co_timer_init(&s->timer, timer_handler, &node->lock, node);
@@ -245,7 +262,7 @@ int co_sync_init(struct co_node *node)
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
-void co_sync_reset_comm(struct co_node *node)
+static void sync_reset_comm(struct co_node *node)
 {
 	struct co_sync *s = &node->sync;
 	struct co_od_info info;
@@ -254,11 +271,11 @@ void co_sync_reset_comm(struct co_node *node)
 	if (co_od_find(&node->od, IDX_COB_ID, 0, &info) != 0U) {
 		s->cob_id = COB_EXT;
 	} else {
-		s->cob_id = (uint32_t)od_uint(node, IDX_COB_ID, 0, CO_SYNC_COB_ID);
+		s->cob_id = (uint32_t)co_od_uint(&node->od, IDX_COB_ID, 0, CO_SYNC_COB_ID);
 	}
-	s->period_us = (uint32_t)od_uint(node, IDX_PERIOD, 0, 0U);
-	s->window_us = (uint32_t)od_uint(node, IDX_WINDOW, 0, 0U);
-	s->overflow = (uint8_t)od_uint(node, IDX_OVERFLOW, 0, 0U);
+	s->period_us = (uint32_t)co_od_uint(&node->od, IDX_PERIOD, 0, 0U);
+	s->window_us = (uint32_t)co_od_uint(&node->od, IDX_WINDOW, 0, 0U);
+	s->overflow = (uint8_t)co_od_uint(&node->od, IDX_OVERFLOW, 0, 0U);
 	if (s->overflow == 1U || s->overflow > 240U) {
 		s->overflow = 0U;
 	}
@@ -266,10 +283,12 @@ void co_sync_reset_comm(struct co_node *node)
 	producer_restart(node);
 }
 
-void co_sync_set_state(struct co_node *node, enum co_nmt_state to)
+static void sync_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
 	struct co_sync *s = &node->sync;
 	bool on = to == CO_NMT_PRE_OPERATIONAL || to == CO_NMT_OPERATIONAL;
+
+	ARG_UNUSED(from);
 
 	if (on == s->enabled) {
 		return;
@@ -277,6 +296,13 @@ void co_sync_set_state(struct co_node *node, enum co_nmt_state to)
 	s->enabled = on;
 	producer_restart(node);
 }
+
+const struct co_service co_service_sync = {
+	.name = "sync",
+	.init = sync_init,
+	.reset_comm = sync_reset_comm,
+	.set_state = sync_set_state,
+};
 
 void co_sync_set_ind(struct co_node *node, co_sync_ind_t cb, void *user_data)
 {

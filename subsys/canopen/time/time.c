@@ -24,6 +24,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/cob_id.h>
 #include <canopen/node.h>
 #include <canopen/time.h>
 
@@ -212,7 +213,7 @@ static void rx_configure(struct co_node *node)
 		co_rx_unregister(&ts->rx);
 		return;
 	}
-	if (co_rx_set_id(node->line, &ts->rx, ts->cob_id & 0x7ffU) != 0) {
+	if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &ts->rx, ts->cob_id & 0x7ffU) != 0) {
 		LOG_ERR("%s: no receive slot for TIME", node->name);
 	}
 }
@@ -230,6 +231,10 @@ static uint32_t cob_validate(struct co_od *od, struct co_od_req *req, void *user
 	}
 	/* Only 11-bit TIME is served (CiA 301 §7.5.2.12: bit 29 set -> 06090030h). */
 	if ((v & COB_EXT) != 0U || (v & 0x1ffff800U) != 0U) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	/* CiA 301 §7.3.5: not on another service's identifier. */
+	if (co_cob_id_restricted(v & 0x7ffU)) {
 		return CO_SDO_AB_INVALID_VALUE;
 	}
 	if (!IS_ENABLED(CONFIG_CANOPEN_TIME_PRODUCER) && (v & CO_TIME_COB_PRODUCE) != 0U) {
@@ -252,11 +257,17 @@ static void cob_notify(struct co_od *od, const struct co_od_req *req, void *user
 
 /* --- Node interface ----------------------------------------------------------------------- */
 
-int co_time_init(struct co_node *node)
+static int time_init(struct co_node *node)
 {
 	struct co_time_svc *ts = &node->time;
 	const struct co_od_hook hooks[] = {
-		{IDX_COB_ID, IDX_COB_ID, 0, 0, cob_validate, cob_notify, node},
+		{
+			.index_first = IDX_COB_ID,
+			.index_last = IDX_COB_ID,
+			.validate = cob_validate,
+			.notify = cob_notify,
+			.user_data = node,
+		},
 	};
 
 	co_rx_init(&ts->rx, 0U, time_rx, &node->lock, node);
@@ -266,19 +277,12 @@ int co_time_init(struct co_node *node)
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
 
-void co_time_reset_comm(struct co_node *node)
+static void time_reset_comm(struct co_node *node)
 {
 	struct co_time_svc *ts = &node->time;
-	uint8_t buf[4] = {0};
-	size_t len = 0;
 
 	/* Without 1012h the node neither produces nor consumes TIME. */
-	if (co_od_read(&node->od, IDX_COB_ID, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP) !=
-	    0U) {
-		ts->cob_id = 0U;
-	} else {
-		ts->cob_id = (uint32_t)co_od_le_get(buf, len);
-	}
+	ts->cob_id = co_od_uint(&node->od, IDX_COB_ID, 0, 0U);
 	if (!IS_ENABLED(CONFIG_CANOPEN_TIME_PRODUCER)) {
 		ts->cob_id &= ~CO_TIME_COB_PRODUCE;
 	}
@@ -286,11 +290,19 @@ void co_time_reset_comm(struct co_node *node)
 	rx_configure(node);
 }
 
-void co_time_set_state(struct co_node *node, enum co_nmt_state to)
+static void time_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
 {
+	ARG_UNUSED(from);
 	/* CiA 301 Table 82: TIME in Pre-operational and Operational only. */
 	node->time.enabled = to == CO_NMT_PRE_OPERATIONAL || to == CO_NMT_OPERATIONAL;
 }
+
+const struct co_service co_service_time = {
+	.name = "time",
+	.init = time_init,
+	.reset_comm = time_reset_comm,
+	.set_state = time_set_state,
+};
 
 /* --- API ---------------------------------------------------------------------------------- */
 
@@ -331,7 +343,7 @@ int co_time_req(struct co_node *node, const struct co_time *t)
 	}
 	f.id = ts->cob_id & 0x7ffU;
 	co_time_encode(t, f.data);
-	err = co_node_send(node, &f);
+	err = co_node_send(node, CO_ROUTE_DEFAULT, &f);
 out:
 	co_node_unlock(node);
 	return err;

@@ -122,7 +122,9 @@ static void send_nmt(uint8_t cs, uint8_t id)
 {
 	struct can_frame f = {.id = CO_NMT_COB_ID, .dlc = 2, .data = {cs, id}};
 
-	(void)co_node_send(&monitor, &f);
+	co_node_lock(&monitor);
+	(void)co_node_send(&monitor, CO_ROUTE_DEFAULT, &f);
+	co_node_unlock(&monitor);
 }
 
 static int start_monitor(void)

@@ -484,21 +484,24 @@ ZTEST(co_emcy, test_node_without_emcy_objects_tracks_errors_and_sends_nothing)
 	uint8_t reg = 0xff;
 	size_t len = 0;
 	uint8_t op = 0x05;
-	uint8_t entry[4] = {0x64, 0x00, 0x05, 0x00}; /* 1016h: node 5, 100 ms */
 
 	zassert_ok(co_node_init(&bare, "bare", &sim.line, &emcy_bare_od_def, &bare_ram, 0x22));
 	zassert_ok(co_node_start(&bare));
+	co_node_lock(&bare);
 	zassert_ok(
 		co_od_write(co_node_od(&bare), 0x1017, 0, (uint8_t[]){0, 0}, 2, CO_OD_WRITER_SDO));
+	co_node_unlock(&bare);
 	sim.n_sent = 0;
 	zassert_ok(co_emcy_raise(&bare, 0x4210, CO_EMCY_REG_TEMPERATURE, NULL));
+	co_node_lock(&bare);
 	zassert_ok(co_od_read(co_node_od(&bare), 0x1001, 0, 0, &reg, 1, &len, CO_OD_WRITER_SDO));
+	co_node_unlock(&bare);
 	zassert_equal(reg, 0x09);
 	zassert_ok(co_emcy_clear(&bare, 0x4210));
 	zassert_equal(sim.n_sent, 0, "no 1014h: no EMCY producer");
 
 	/* Lose node 5's heartbeat in Operational: the default 1029h behaviour applies. */
-	zassert_ok(co_od_write(co_node_od(&bare), 0x1016, 1, entry, 4, CO_OD_WRITER_SDO));
+	zassert_equal(co_sim_write(&bare, 0x1016, 1, 0x00050064U, 4), 0U);
 	zassert_ok(co_nmt_req(&bare, CO_NMT_CS_START));
 	co_sim_rx(0x705, 1, &op);
 	co_sim_run_until(sim.now + 100 * MS);

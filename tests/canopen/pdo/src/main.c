@@ -59,7 +59,9 @@ static uint8_t get_u8(uint16_t index, uint8_t sub)
 {
 	uint8_t v = 0xEE;
 
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_u8(co_node_od(&t.node), index, sub, &v));
+	co_node_unlock(&t.node);
 	return v;
 }
 
@@ -195,7 +197,9 @@ ZTEST(co_pdo, test_rpdo_applied_only_in_operational)
 	go_operational();
 	co_sim_rx(0x200 + NODE_ID, 3, d);
 	zassert_equal(get_u8(0x2000, 1), 0x11);
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_u16(co_node_od(&t.node), 0x2001, 0, &w));
+	co_node_unlock(&t.node);
 	zassert_equal(w, 0x1234, "little endian");
 	zassert_equal(t.n_rpdo_ind, 1);
 	zassert_equal(t.rpdo_ind_num, 0);
@@ -725,7 +729,9 @@ ZTEST(co_pdo, test_mapping_procedure_abort_codes)
 		      "MPDO not built in");
 #endif
 	zassert_equal(co_sim_write(&t.node, 0x1A00, 0, 8, 1), 0U, "8 x 8 bits");
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_u8(co_node_od(&t.node), 0x1A00, 0, &n));
+	co_node_unlock(&t.node);
 	zassert_equal(n, 8);
 	zassert_equal(co_sim_write(&t.node, 0x1800, 1, 0x180 + NODE_ID, 4), 0U, "step 5");
 
@@ -792,11 +798,17 @@ ZTEST(co_pdo, test_bitwise_mapping)
 	setup_pdo(false, 1, 0x2A1, 254, tmap, 4);
 	go_operational();
 	co_sim_rx(0x321, 3, d);
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_bool(co_node_od(&t.node), 0x2005, 1, &b));
+	co_node_unlock(&t.node);
 	zassert_true(b);
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_bool(co_node_od(&t.node), 0x2005, 2, &b));
+	co_node_unlock(&t.node);
 	zassert_false(b);
+	co_node_lock(&t.node);
 	zassert_ok(co_od_get_i16(co_node_od(&t.node), 0x2006, 0, &s));
+	co_node_unlock(&t.node);
 	zassert_equal(s, -5, "12-bit two's complement, sign-extended");
 	zassert_equal(get_u8(0x2000, 4), 0x5A);
 	zassert_equal(count(EMCY_ID), 0, "23 bits need 3 bytes");

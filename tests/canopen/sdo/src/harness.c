@@ -150,8 +150,10 @@ void h_setup(void)
 	h.prov.index_last = 0x30ff;
 	co_line_init_sim(&h.line, "sim", sink, NULL);
 	zassert_ok(co_node_init(&h.node, "dut", &h.line, &sdo_test_od_def, &h.ram, NODE_ID));
+	co_node_lock(&h.node);
 	zassert_ok(co_od_provider_register(co_node_od(&h.node), &h.prov));
 	zassert_ok(co_od_hook_register(co_node_od(&h.node), &hook));
+	co_node_unlock(&h.node);
 	zassert_ok(co_node_start(&h.node));
 	/* Boot-up. */
 	zassert_true(h_pending() >= 1U);

@@ -230,3 +230,35 @@ void h_nmt(uint8_t cs, uint8_t id)
 	co_line_rx(&h.line, &f, h.now);
 	h_pump();
 }
+
+uint32_t h_od_write(struct co_node *n, uint16_t idx, uint8_t sub, const void *data, size_t len,
+		    enum co_od_writer w)
+{
+	uint32_t ab;
+
+	co_node_lock(n);
+	ab = co_od_write(co_node_od(n), idx, sub, data, len, w);
+	co_node_unlock(n);
+	return ab;
+}
+
+uint32_t h_od_read(struct co_node *n, uint16_t idx, uint8_t sub, uint32_t off, void *buf,
+		   size_t cap, size_t *len, enum co_od_writer r)
+{
+	uint32_t ab;
+
+	co_node_lock(n);
+	ab = co_od_read(co_node_od(n), idx, sub, off, buf, cap, len, r);
+	co_node_unlock(n);
+	return ab;
+}
+
+uint32_t h_od_set_u32(struct co_node *n, uint16_t idx, uint8_t sub, uint32_t v, enum co_od_writer w)
+{
+	uint32_t ab;
+
+	co_node_lock(n);
+	ab = co_od_set_u32(co_node_od(n), idx, sub, v, w);
+	co_node_unlock(n);
+	return ab;
+}

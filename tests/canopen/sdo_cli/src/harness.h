@@ -100,4 +100,12 @@ void h_fill(uint8_t *p, size_t len, uint32_t seed);
 uint16_t ref_crc16(const uint8_t *p, size_t len);
 void h_nmt(uint8_t cs, uint8_t id);
 
+/* The dictionary accessors with the node's mutex held, as the lock rule wants. */
+uint32_t h_od_write(struct co_node *n, uint16_t idx, uint8_t sub, const void *data, size_t len,
+		    enum co_od_writer w);
+uint32_t h_od_read(struct co_node *n, uint16_t idx, uint8_t sub, uint32_t off, void *buf,
+		   size_t cap, size_t *len, enum co_od_writer r);
+uint32_t h_od_set_u32(struct co_node *n, uint16_t idx, uint8_t sub, uint32_t v,
+		      enum co_od_writer w);
+
 #endif /* SDO_CLI_TEST_HARNESS_H_ */

@@ -21,14 +21,24 @@ static void before(void *f)
 static uint32_t cobid(uint16_t idx, uint8_t sub)
 {
 	uint32_t v = 0;
+	uint32_t code;
 
-	zassert_equal(co_od_get_u32(co_node_od(&h.cnode), idx, sub, &v), 0U);
+	/* The dictionary accessors require the node's mutex. */
+	co_node_lock(&h.cnode);
+	code = co_od_get_u32(co_node_od(&h.cnode), idx, sub, &v);
+	co_node_unlock(&h.cnode);
+	zassert_equal(code, 0U);
 	return v;
 }
 
 static uint32_t set(uint16_t idx, uint8_t sub, uint32_t v, enum co_od_writer w)
 {
-	return co_od_set_u32(co_node_od(&h.cnode), idx, sub, v, w);
+	uint32_t code;
+
+	co_node_lock(&h.cnode);
+	code = co_od_set_u32(co_node_od(&h.cnode), idx, sub, v, w);
+	co_node_unlock(&h.cnode);
+	return code;
 }
 
 static uint32_t read_u32(uint8_t num, uint16_t idx)
@@ -47,6 +57,7 @@ static uint32_t read_u32(uint8_t num, uint16_t idx)
 
 ZTEST(sdo_cli_config, test_set_server_writes_1280h)
 {
+	uint32_t code;
 	uint8_t id = 0;
 
 	zassert_equal(cobid(0x1280, 1), 0x80000000U);
@@ -56,14 +67,16 @@ ZTEST(sdo_cli_config, test_set_server_writes_1280h)
 	zassert_ok(co_sdo_cli_set_server(h_cli(0), SRV_ID));
 	zassert_equal(cobid(0x1280, 1), 0x600U + SRV_ID);
 	zassert_equal(cobid(0x1280, 2), 0x580U + SRV_ID);
-	zassert_equal(co_od_get_u8(co_node_od(&h.cnode), 0x1280, 3, &id), 0U);
+	co_node_lock(&h.cnode);
+	code = co_od_get_u8(co_node_od(&h.cnode), 0x1280, 3, &id);
+	co_node_unlock(&h.cnode);
+	zassert_equal(code, 0U);
 	zassert_equal(id, SRV_ID);
 	zassert_equal(read_u32(0, 0x2004), 0x12345678U);
 	/* Re-binding a valid client to another server is allowed through the API. */
 	zassert_ok(co_sdo_cli_set_server(h_cli(0), SRV2_ID));
 	zassert_equal(cobid(0x1280, 1), 0x600U + SRV2_ID);
-	zassert_equal(co_od_set_u32(co_node_od(&h.snode2), 0x2004, 0, 0xFEEDU, CO_OD_WRITER_APP),
-		      0U);
+	zassert_equal(h_od_set_u32(&h.snode2, 0x2004, 0, 0xFEEDU, CO_OD_WRITER_APP), 0U);
 	zassert_equal(read_u32(0, 0x2004), 0xFEEDU);
 }
 
@@ -84,7 +97,7 @@ ZTEST(sdo_cli_config, test_cobid_rules_06090030)
 	/* An 11-bit COB-ID with bits 28..11 set. */
 	zassert_equal(set(0x1281, 1, 0x1000600, CO_OD_WRITER_SDO), CO_SDO_AB_INVALID_VALUE);
 	/* Wrong length: the dictionary refuses it before the hook. */
-	zassert_equal(co_od_write(co_node_od(&h.cnode), 0x1281, 1, buf, 2, CO_OD_WRITER_SDO),
+	zassert_equal(h_od_write(&h.cnode, 0x1281, 1, buf, 2, CO_OD_WRITER_SDO),
 		      CO_SDO_AB_DATA_SHORT);
 	zassert_equal(cobid(0x1281, 1), 0x80000000U);
 }
@@ -103,8 +116,7 @@ ZTEST(sdo_cli_config, test_write_reconfigures_at_once)
 	zassert_equal(set(0x1281, 2, 0x80000000U, CO_OD_WRITER_SDO), 0U);
 	zassert_equal(set(0x1281, 2, 0x580U + SRV2_ID, CO_OD_WRITER_SDO), 0U);
 	zassert_equal(set(0x1281, 1, 0x600U + SRV2_ID, CO_OD_WRITER_SDO), 0U);
-	zassert_equal(co_od_set_u32(co_node_od(&h.snode2), 0x2004, 0, 0xBEEFU, CO_OD_WRITER_APP),
-		      0U);
+	zassert_equal(h_od_set_u32(&h.snode2, 0x2004, 0, 0xBEEFU, CO_OD_WRITER_APP), 0U);
 	zassert_equal(read_u32(1, 0x2004), 0xBEEFU);
 }
 

@@ -56,8 +56,7 @@ static uint32_t ul(uint8_t num, uint16_t idx, uint8_t sub, void *buf, size_t cap
 /* Value of the server's dictionary. */
 static void srv_read(uint16_t idx, void *buf, size_t cap, size_t *len)
 {
-	zassert_equal(co_od_read(co_node_od(&h.snode), idx, 0, 0, buf, cap, len, CO_OD_WRITER_APP),
-		      0U);
+	zassert_equal(h_od_read(&h.snode, idx, 0, 0, buf, cap, len, CO_OD_WRITER_APP), 0U);
 }
 
 /* Count the frames on 600h + SRV_ID / 580h + SRV_ID since the last call. */
@@ -208,8 +207,7 @@ ZTEST(sdo_cli_transfers, test_block_upload_sizes_and_protocol_switch)
 		bool sw = CONFIG_CANOPEN_SDO_CLIENT_PST != 0 && n <= CONFIG_CANOPEN_SDO_CLIENT_PST;
 
 		h_fill(out, n, 200 + (uint32_t)i);
-		zassert_equal(
-			co_od_write(co_node_od(&h.snode), 0x2005, 0, out, n, CO_OD_WRITER_APP), 0U);
+		zassert_equal(h_od_write(&h.snode, 0x2005, 0, out, n, CO_OD_WRITER_APP), 0U);
 		h_skip_all();
 		memset(in, 0xEE, sizeof(in));
 		zassert_equal(ul(0, 0x2005, 0, in, DOM_SIZE, &len, CO_SDO_CLI_BLOCK), 0U,
@@ -260,7 +258,7 @@ ZTEST(sdo_cli_transfers, test_upload_longer_than_buffer_is_aborted_05040005)
 	struct co_sdo_srv_stats st;
 
 	h_fill(out, 100, 7);
-	zassert_equal(co_od_write(co_node_od(&h.snode), 0x2005, 0, out, 100, CO_OD_WRITER_APP), 0U);
+	zassert_equal(h_od_write(&h.snode, 0x2005, 0, out, 100, CO_OD_WRITER_APP), 0U);
 	zassert_equal(ul(0, 0x2005, 0, in, 99, &len, CO_SDO_CLI_AUTO), CO_SDO_AB_OUT_OF_MEM);
 	zassert_equal(ul(0, 0x2005, 0, in, 99, &len, CO_SDO_CLI_BLOCK), CO_SDO_AB_OUT_OF_MEM);
 	/* Expedited value into a buffer of 2. */
@@ -323,8 +321,7 @@ ZTEST(sdo_cli_transfers, test_several_clients_to_several_servers_concurrently)
 		h_fill(o[i], sizeof(o[i]), 300 + i);
 		memset(&h.con[i], 0, sizeof(h.con[i]));
 	}
-	zassert_equal(co_od_write(co_node_od(&h.snode3), 0x2005, 0, o[3], 1999, CO_OD_WRITER_APP),
-		      0U);
+	zassert_equal(h_od_write(&h.snode3, 0x2005, 0, o[3], 1999, CO_OD_WRITER_APP), 0U);
 	zassert_ok(co_sdo_cli_download_req(h_cli(0), 0x2005, 0, o[0], 2000, CO_SDO_CLI_BLOCK, 0,
 					   h_con, CON(0)));
 	zassert_ok(co_sdo_cli_download_req(h_cli(1), 0x2005, 0, o[1], 1500, CO_SDO_CLI_AUTO, 0,
@@ -353,14 +350,10 @@ ZTEST(sdo_cli_transfers, test_several_clients_to_several_servers_concurrently)
 	zassert_equal(h.con[3].size, 1999U);
 	zassert_equal(sys_get_le32(r[2]), 0xA5A5A5A5);
 	zassert_mem_equal(r[3], o[3], 1999);
-	zassert_equal(
-		co_od_read(co_node_od(&h.snode), 0x2005, 0, 0, r[0], 2000, &len, CO_OD_WRITER_APP),
-		0U);
+	zassert_equal(h_od_read(&h.snode, 0x2005, 0, 0, r[0], 2000, &len, CO_OD_WRITER_APP), 0U);
 	zassert_equal(len, 2000U);
 	zassert_mem_equal(r[0], o[0], 2000);
-	zassert_equal(
-		co_od_read(co_node_od(&h.snode2), 0x2005, 0, 0, r[1], 2000, &len, CO_OD_WRITER_APP),
-		0U);
+	zassert_equal(h_od_read(&h.snode2, 0x2005, 0, 0, r[1], 2000, &len, CO_OD_WRITER_APP), 0U);
 	zassert_equal(len, 1500U);
 	zassert_mem_equal(r[1], o[1], 1500);
 }
@@ -399,9 +392,7 @@ ZTEST(sdo_cli_transfers, test_empty_values_every_protocol)
 	for (size_t m = 0; m < ARRAY_SIZE(modes); m++) {
 		size_t len = 99;
 
-		zassert_equal(
-			co_od_write(co_node_od(&h.snode), 0x2005, 0, out, 10, CO_OD_WRITER_APP),
-			0U);
+		zassert_equal(h_od_write(&h.snode, 0x2005, 0, out, 10, CO_OD_WRITER_APP), 0U);
 		zassert_equal(dl(0, 0x2005, 0, NULL, 0, modes[m]), 0U, "mode %zu", m);
 		srv_read(0x2005, in, sizeof(in), &len);
 		zassert_equal(len, 0U, "mode %zu", m);

@@ -363,15 +363,15 @@ ZTEST(co_time, test_producer_reaches_consumer_on_same_line)
 
 ZTEST(co_time, test_1012h_write_rules)
 {
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x00000101U), 0U, "unused: id may change");
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000101U), 0U);
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000102U), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x00000190U), 0U, "unused: id may change");
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000190U), 0U);
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000191U), CO_SDO_AB_INVALID_VALUE,
 		      "consumer keeps its CAN-ID");
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x40000101U), 0U, "same id, other role");
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x40000102U), CO_SDO_AB_INVALID_VALUE,
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x40000190U), 0U, "same id, other role");
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x40000191U), CO_SDO_AB_INVALID_VALUE,
 		      "producer keeps its CAN-ID");
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0xC0000101U), 0U, "both roles");
-	zassert_equal(od_write_u32(&t.node, 0x1012, 0x00000101U), 0U, "off");
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0xC0000190U), 0U, "both roles");
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x00000190U), 0U, "off");
 	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000100U), 0U, "then a new id");
 	zassert_equal(od_write_u32(&t.node, 0x1012, 0x20000100U), CO_SDO_AB_INVALID_VALUE,
 		      "29-bit frames are not supported");

@@ -1,6 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The ztest console output, parsed with the regexes of Zephyr's twister (harness.py, as
-listed in shared/spec/style-anchors.md section 6.3)."""
+"""The ztest console output, parsed with the regexes of Zephyr's twister (its harness.py)."""
 
 import re
 

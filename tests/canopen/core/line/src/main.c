@@ -396,6 +396,7 @@ ZTEST(co_line, test_wrap_safe_time_comparison)
 ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 {
 	struct k_mutex node_a, node_b;
+	struct co_line_member ma, mb;
 	struct co_rx ra, rb;
 	struct can_frame f = std_frame(0x701, 1);
 
@@ -409,12 +410,12 @@ ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 	zassert_ok(co_rx_register(&fx.line, &rb));
 
 	/* One node on the line: nothing to deliver locally. */
-	co_line_attach(&fx.line);
+	co_line_attach(&fx.line, &ma, &node_a);
 	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
 	zassert_equal(co_line_process(&fx.line, 10), UINT64_MAX);
 	zassert_equal(fx.log_len, 0);
 
-	co_line_attach(&fx.line);
+	co_line_attach(&fx.line, &mb, &node_b);
 	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
 	zassert_equal(fx.sent_len, 2, "the frame still goes to the bus");
 	zassert_equal(fx.log_len, 0, "delivered in the line's context, not inside the send");

@@ -185,7 +185,9 @@ ZTEST(co_threaded, test_nmt_command_from_a_node_reaches_its_neighbour)
 {
 	struct can_frame f = {.id = 0x000, .dlc = 2, .data = {CO_NMT_CS_START, id_of(0, 1)}};
 
-	zassert_ok(co_node_send(&nodes[0][0].node, &f));
+	co_node_lock(&nodes[0][0].node);
+	zassert_ok(co_node_send(&nodes[0][0].node, CO_ROUTE_DEFAULT, &f));
+	co_node_unlock(&nodes[0][0].node);
 	zassert_true(wait_until(node2_operational));
 	zassert_equal(co_nmt_get_state(&nodes[0][0].node), CO_NMT_PRE_OPERATIONAL,
 		      "the sender is not addressed");

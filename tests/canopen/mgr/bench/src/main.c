@@ -4,7 +4,7 @@
  */
 
 /*
- * Manager boot-up benchmark (DESIGN.md §7): figures only, nothing is judged.
+ * Manager boot-up benchmark (doc/bench.md): figures only, nothing is judged.
  *
  * The CiA 302 manager (node 1) brings 1, 16 and 126 slaves (the whole network) to
  * OPERATIONAL: identity checks 1F84h-1F88h (all five objects read), a 20-entry concise DCF

@@ -4,7 +4,7 @@
  */
 
 /*
- * PDO benchmark (DESIGN.md §7): figures only, nothing is judged.
+ * PDO benchmark (doc/bench.md): figures only, nothing is judged.
  *
  * cost     On a simulation line (no threads, no driver): the time to receive one RPDO
  *          (line dispatch + unpack + dictionary write + a notify hook) and to serve one SYNC
