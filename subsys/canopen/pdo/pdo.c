@@ -95,6 +95,12 @@ static bool is_sync_type(uint8_t type)
 	return type <= CO_PDO_TT_SYNC_MAX;
 }
 
+/* Without the SYNC service nothing would ever trigger a synchronous PDO: refuse the type. */
+static bool sync_type_served(uint8_t type)
+{
+	return IS_ENABLED(CONFIG_CANOPEN_SYNC) || !is_sync_type(type);
+}
+
 static bool is_event_type(uint8_t type)
 {
 	return type == CO_PDO_TT_EVENT_MANUF || type == CO_PDO_TT_EVENT_PROF;
@@ -681,6 +687,9 @@ static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_EVENT_MANUF) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
+		if (!sync_type_served((uint8_t)v)) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
 		/* MPDOs are event-driven only. */
 		return r->mpdo != 0U && !is_event_type((uint8_t)v) ? AB_PDO_STATE : 0U;
 	default:
@@ -751,6 +760,10 @@ static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 		return 0U;
 	case SUB_TYPE:
 		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_RTR_SYNC) {
+			return CO_SDO_AB_INVALID_VALUE;
+		}
+		if (!sync_type_served((uint8_t)v) ||
+		    (v == CO_PDO_TT_RTR_SYNC && !IS_ENABLED(CONFIG_CANOPEN_SYNC))) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		if (is_rtr_type((uint8_t)v) && (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) ||
@@ -1036,6 +1049,11 @@ static void pdo_reset_comm(struct co_node *node)
 		}
 		r->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
 		r->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		if (!sync_type_served(r->type)) {
+			LOG_ERR("%s: RPDO %u is synchronous, the node has no SYNC; it stays off",
+				node->name, i + 1U);
+			r->cob_id |= CO_PDO_COB_INVALID;
+		}
 		r->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
 		if (map_load(node, true, i, r->type, &r->map, &r->mpdo) != 0U) {
 			r->cob_id |= CO_PDO_COB_INVALID;
@@ -1051,6 +1069,12 @@ static void pdo_reset_comm(struct co_node *node)
 		}
 		t->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
 		t->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+		if (!sync_type_served(t->type) ||
+		    (t->type == CO_PDO_TT_RTR_SYNC && !IS_ENABLED(CONFIG_CANOPEN_SYNC))) {
+			LOG_ERR("%s: TPDO %u is synchronous, the node has no SYNC; it stays off",
+				node->name, i + 1U);
+			t->cob_id |= CO_PDO_COB_INVALID;
+		}
 		t->inhibit_us = (uint32_t)co_od_uint(&node->od, comm, SUB_INHIBIT, 0U) * 100U;
 		t->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
 		t->sync_start = (uint8_t)co_od_uint(&node->od, comm, SUB_SYNC_START, 0U);

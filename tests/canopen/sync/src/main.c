@@ -96,6 +96,28 @@ ZTEST(co_sync, test_counter_runs_1_to_1019h_then_wraps)
 	}
 }
 
+ZTEST(co_sync, test_1005h_refuses_restricted_can_ids_06090030h)
+{
+	static const uint32_t restricted[] = {0x000, 0x001, 0x07F, 0x101, 0x180, 0x581, 0x5FF,
+					      0x601, 0x67F, 0x6E0, 0x6FF, 0x701, 0x77F, 0x7FF};
+
+	for (size_t i = 0; i < ARRAY_SIZE(restricted); i++) {
+		zassert_equal(co_sim_write(&t.node, 0x1005, 0, 0x40000000U | restricted[i], 4),
+			      CO_SDO_AB_INVALID_VALUE, "producer on %03x", restricted[i]);
+		zassert_equal(co_sim_write(&t.node, 0x1005, 0, restricted[i], 4),
+			      CO_SDO_AB_INVALID_VALUE, "consumer on %03x", restricted[i]);
+	}
+	/* The attack of the fuzzing campaign: SYNC on the NMT identifier every millisecond. */
+	zassert_equal(co_sim_write(&t.node, 0x1005, 0, 0x40000000U, 4), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1006, 0, 1000, 4), 0U);
+	sim.n_sent = 0;
+	co_sim_run_until(sim.now + 10 * MS);
+	for (int i = 0; i < sim.n_sent; i++) {
+		zassert_not_equal(sim.sent[i].id, 0x000, "nothing on the NMT identifier");
+	}
+	zassert_equal(co_sim_write(&t.node, 0x1005, 0, 0x00000081U, 4), 0U, "081h is free");
+}
+
 ZTEST(co_sync, test_1019h_write_rules_08000022h_and_06090030h)
 {
 	zassert_equal(co_sim_write(&t.node, 0x1019, 0, 1, 1), CO_SDO_AB_INVALID_VALUE,

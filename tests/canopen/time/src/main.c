@@ -361,6 +361,18 @@ ZTEST(co_time, test_producer_reaches_consumer_on_same_line)
 
 /* --- 1012h write rules ---------------------------------------------------------------------- */
 
+ZTEST(co_time, test_1012h_refuses_restricted_can_ids_06090030h)
+{
+	static const uint32_t restricted[] = {0x000, 0x040, 0x07F, 0x101, 0x180,
+					      0x581, 0x601, 0x6E0, 0x701, 0x7FF};
+
+	for (size_t i = 0; i < ARRAY_SIZE(restricted); i++) {
+		zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000000U | restricted[i]),
+			      CO_SDO_AB_INVALID_VALUE, "%03x", restricted[i]);
+	}
+	zassert_equal(od_write_u32(&t.node, 0x1012, 0x80000100U), 0U, "100h is TIME's own");
+}
+
 ZTEST(co_time, test_1012h_write_rules)
 {
 	zassert_equal(od_write_u32(&t.node, 0x1012, 0x00000190U), 0U, "unused: id may change");

@@ -393,6 +393,59 @@ ZTEST(co_line, test_wrap_safe_time_comparison)
 	zassert_false(co_time_before_eq(5, UINT64_MAX - 10));
 }
 
+ZTEST(co_line, test_receivers_beyond_the_fanout_are_counted)
+{
+	static struct co_rx rx[CONFIG_CANOPEN_LINE_RX_FANOUT + 2];
+	struct can_frame f = std_frame(0x080, 0);
+	struct co_line_stats st;
+
+	for (int i = 0; i < (int)ARRAY_SIZE(rx); i++) {
+		rx_fill(&rx[i], 0x080, 0x7ff, false, i);
+		zassert_ok(co_rx_register(&fx.line, &rx[i]));
+	}
+	zassert_equal(co_line_rx(&fx.line, &f, 1), CONFIG_CANOPEN_LINE_RX_FANOUT);
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.rx_fanout_drops, 2, "the two receivers the frame missed");
+	zassert_equal(fx.log[0], 0, "the first registered get it");
+	for (int i = 0; i < (int)ARRAY_SIZE(rx); i++) {
+		co_rx_unregister(&rx[i]);
+	}
+}
+
+ZTEST(co_line, test_set_id_moves_a_receiver_to_another_line)
+{
+	static struct co_line other;
+	struct can_frame f = std_frame(0x181, 1);
+	struct co_rx rx;
+
+	co_line_init_sim(&other, "sim1", sink, NULL);
+	rx_fill(&rx, 0x181, 0x7ff, false, 7);
+	zassert_ok(co_rx_register(&fx.line, &rx));
+	zassert_ok(co_rx_set_id(&other, &rx, 0x181));
+	zassert_equal(co_line_rx(&fx.line, &f, 1), 0, "gone from the first line's table");
+	zassert_equal(co_line_rx(&other, &f, 2), 1, "and in the other's");
+	zassert_ok(co_rx_set_id(&other, &rx, 0x182), "moved within the line");
+	zassert_equal(co_line_rx(&other, &f, 3), 0);
+	co_rx_unregister(&rx);
+	zassert_equal(fx.log_len, 1);
+}
+
+ZTEST(co_line, test_line_knows_whether_a_node_lock_is_held)
+{
+	struct co_line_member m;
+
+	zassert_false(co_line_owner_held(&fx.line), "no node attached");
+	co_line_attach(&fx.line, &m, &fx.node_lock);
+	zassert_false(co_line_owner_held(&fx.line));
+	k_mutex_lock(&fx.node_lock, K_FOREVER);
+	zassert_true(co_line_owner_held(&fx.line));
+	k_mutex_unlock(&fx.node_lock);
+	zassert_false(co_line_owner_held(&fx.line));
+	zassert_is_null(co_line_current(), "the test thread is no line thread");
+	co_line_detach(&fx.line, &m);
+	co_line_detach(&fx.line, &m); /* safe twice */
+}
+
 ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 {
 	struct k_mutex node_a, node_b;

@@ -493,7 +493,7 @@ ZTEST(co_node_lock, test_dictionary_access_without_the_lock_stops_the_program)
 
 static void *node_setup(void)
 {
-	if (!full_hook_table(NULL)) {
+	if (!full_hook_table(NULL) || !IS_ENABLED(CONFIG_CANOPEN_SYNC)) {
 		ztest_test_skip();
 	}
 	return NULL;
@@ -510,3 +510,32 @@ static void *lock_setup(void)
 }
 
 ZTEST_SUITE(co_node_lock, NULL, lock_setup, NULL, NULL, NULL);
+
+/* --- Synchronous PDOs need SYNC (scenario canopen.core.node.no_sync) ------------------------ */
+
+static void *no_sync_setup(void)
+{
+	if (IS_ENABLED(CONFIG_CANOPEN_SYNC)) {
+		ztest_test_skip();
+	}
+	return NULL;
+}
+
+ZTEST(co_pdo_without_sync, test_synchronous_types_are_refused_06090030)
+{
+	before(NULL);
+	zassert_ok(co_node_start(&t.node));
+	/* RPDO 1 and TPDO 1: off first, as the mapping procedure wants. */
+	zassert_equal(co_sim_write(&t.node, 0x1400, 1, 0x80000000U | (0x200U + NODE_ID), 4), 0U);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 1, 0x80000000U | (0x180U + NODE_ID), 4), 0U);
+
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 0, 1), CO_SDO_AB_INVALID_VALUE, "acyclic");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 1, 1), CO_SDO_AB_INVALID_VALUE, "cyclic");
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 240, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1400, 2, 254, 1), 0U, "event-driven is served");
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 0, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 10, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 255, 1), 0U);
+}
+
+ZTEST_SUITE(co_pdo_without_sync, NULL, no_sync_setup, NULL, NULL, NULL);
