@@ -372,6 +372,8 @@ struct k_mutex {
 	struct k_thread *owner;
 	uint32_t lock_count;
 	int owner_orig_prio;
+	/* native_posix: 0 free, 1 locked, 2 locked and maybe waited for (the fast path's word). */
+	int state;
 	/** @endcond */
 };
 
@@ -382,6 +384,7 @@ struct k_mutex {
 		.owner = NULL,                                                                     \
 		.lock_count = 0,                                                                   \
 		.owner_orig_prio = K_LOWEST_APPLICATION_THREAD_PRIO,                               \
+		.state = 0,                                                                        \
 	}
 /** @endcond */
 

@@ -53,7 +53,16 @@ void z_lock(void);
 void z_unlock(void);
 
 /* The calling thread (a dummy thread object for host threads the kernel did not create). */
-struct k_thread *z_current(void);
+/* The calling thread's k_thread: inline, since every k_mutex operation asks. */
+extern __thread struct k_thread *z_current_thread;
+struct k_thread *z_current_adopt(void);
+
+static inline struct k_thread *z_current(void)
+{
+	struct k_thread *cur = z_current_thread;
+
+	return cur != NULL ? cur : z_current_adopt();
+}
 
 /* Time since boot in ns on CLOCK_MONOTONIC. */
 int64_t z_now_ns(void);

@@ -25,8 +25,8 @@
 
 static pthread_mutex_t kernel_lock = PTHREAD_MUTEX_INITIALIZER;
 
-/* The k_thread of the calling host thread. */
-static __thread struct k_thread *current;
+/* The k_thread of the calling host thread (read inline by z_current(), kernel_internal.h). */
+__thread struct k_thread *z_current_thread;
 /* Thread object for host threads the kernel did not create (the boot thread, host I/O). */
 static __thread struct k_thread dummy_thread;
 
@@ -81,16 +81,13 @@ static void thread_base_init(struct k_thread *thread, int prio, uint8_t state)
 	z_cond_init_monotonic(&z_host(thread)->cond);
 }
 
-struct k_thread *z_current(void)
+struct k_thread *z_current_adopt(void)
 {
-	if (current == NULL) {
-		/* Adopt the host thread; its dummy object lives as long as the thread. */
-		thread_base_init(&dummy_thread, K_LOWEST_APPLICATION_THREAD_PRIO, Z_THREAD_DUMMY);
-		z_host(&dummy_thread)->pthread = pthread_self();
-		current = &dummy_thread;
-	}
-
-	return current;
+	/* Adopt the host thread; its dummy object lives as long as the thread. */
+	thread_base_init(&dummy_thread, K_LOWEST_APPLICATION_THREAD_PRIO, Z_THREAD_DUMMY);
+	z_host(&dummy_thread)->pthread = pthread_self();
+	z_current_thread = &dummy_thread;
+	return z_current_thread;
 }
 
 k_tid_t k_current_get(void)
@@ -212,7 +209,8 @@ void z_thread_prio_set_locked(struct k_thread *thread, int prio)
 {
 	_wait_q_t *wq = thread->base.pended_on;
 
-	thread->base.prio = prio;
+	/* Atomic: a thread reads its own priority without the kernel lock (k_mutex fast path). */
+	__atomic_store_n(&thread->base.prio, prio, __ATOMIC_RELAXED);
 	if (wq != NULL) {
 		/* Re-sort: the thread's place in its wait queue depends on its priority. */
 		sys_dlist_remove(&thread->base.qnode_dlist);
@@ -272,7 +270,7 @@ static void *thread_trampoline(void *arg)
 	struct z_host_thread *host = z_host(thread);
 	jmp_buf exit_jmp;
 
-	current = thread;
+	z_current_thread = thread;
 
 	z_lock();
 	/* Wait for the start time (INT64_MAX until k_thread_start()) unless aborted first. */
