@@ -12,8 +12,21 @@
  * turns the echo of our own frames into TX completions (first in, first out, as the kernel
  * keeps the order) and error frames into enum can_state.
  *
- * Locking: lock guards state and the in-flight FIFO; rx_lock is held while receive
- * callbacks run and while filters change. No callback runs with lock held.
+ * Stopped means deaf: the socket stays open (its queue keeps the echoes that complete frames
+ * already handed to the kernel), so it also collects the frames that arrive while the
+ * controller is stopped. Whether a frame may be delivered is therefore decided by when it
+ * arrived, not by when the receive thread gets to it: can_start() records the time
+ * (CLOCK_REALTIME, the clock of the kernel's SO_TIMESTAMPNS stamps) and frames stamped
+ * before it are dropped (see sc_rx_fresh_locked()).
+ *
+ * Frames handed to the kernel cannot be recalled (no socket call takes a frame back out of
+ * the interface's queue), so can_stop() does not report them aborted: it waits for their
+ * echoes, up to CONFIG_CAN_SOCKETCAN_STOP_DRAIN_MS, and their callbacks get 0 (sent).
+ *
+ * Locking: lock guards started, state, the in-flight FIFO and the receive gate; rx_lock is
+ * held while receive callbacks run, while filters change and across the "started and fresh?"
+ * decision for a frame and its delivery, so that no receive callback runs once can_stop() has
+ * returned. Order: rx_lock before lock. No callback runs with lock held.
  */
 
 #include <errno.h>
@@ -71,9 +84,14 @@ struct sc_data {
 	struct sc_tx inflight[SC_TXQ_SIZE]; /* FIFO of frames awaiting their echo */
 	uint16_t head;
 	uint16_t count;
-	uint32_t stale_echoes; /* echoes still due for frames aborted by stop/bus-off */
+	uint32_t stale_echoes; /* echoes still due for frames aborted by bus-off */
+	/* receive gate: frames stamped before the last can_start() are not delivered */
+	uint64_t start_real_ns;  /* CLOCK_REALTIME at the last can_start() */
+	int64_t start_offset_ns; /* CLOCK_REALTIME - CLOCK_MONOTONIC then (to see clock steps) */
+	bool draining;           /* frames from before that start may still be queued */
 	struct k_sem tx_slots;
 	struct k_sem echo_seen; /* given on every echo: room in the kernel queue again */
+	struct k_sem tx_idle;   /* given whenever the in-flight FIFO becomes empty */
 	/* guarded by rx_lock */
 	struct k_mutex rx_lock;
 	struct can_filter_slot filters[SC_MAX_FILTERS];
@@ -187,11 +205,14 @@ static bool sc_pop_locked(struct sc_data *d, struct sc_tx *out)
 	*out = d->inflight[d->head];
 	d->head = (uint16_t)((d->head + 1U) % SC_TXQ_SIZE);
 	d->count--;
+	if (d->count == 0U) {
+		k_sem_give(&d->tx_idle);
+	}
 
 	return true;
 }
 
-/* Aborts every in-flight frame: their echoes will be ignored. Under lock. */
+/* Aborts every in-flight frame (bus-off): their echoes will be ignored. Under lock. */
 static int sc_abort_locked(struct sc_data *d, struct sc_tx out[SC_TXQ_SIZE])
 {
 	int n = 0;
@@ -214,17 +235,81 @@ static void sc_run_aborted(struct sc_data *d, const struct sc_tx *t, int n, int 
 	}
 }
 
-static void sc_deliver(struct sc_data *d, const struct can_frame *frame)
+/* A wall-clock step backwards of more than this since can_start() makes the stamps useless. */
+#define SC_CLOCK_STEP_NS 10000000LL
+
+/*
+ * Whether a frame the kernel stamped at @p rx_real_ns arrived after the last can_start().
+ * Under lock, in the same critical section that reads started (else a frame judged before a
+ * start could be delivered after it).
+ *
+ * Why stamps: the receive thread may read a frame long after it arrived (it was busy, or the
+ * frame sat in the socket while we were stopped), so "started when read" says nothing about
+ * "started when it arrived". A lock cannot close that window, and closing/reopening the socket
+ * would lose the echoes of frames still in flight. The kernel stamps each frame when it
+ * arrives (netif_rx) with CLOCK_REALTIME; can_start() reads the same clock, so the comparison
+ * is exact. The socket's queue is FIFO: once one frame stamped at or after the start has been
+ * read, everything behind it arrived later, and the check is off until the next start
+ * ("draining"). That also bounds what a wall-clock step can do: only a step backwards while
+ * draining matters, and one larger than SC_CLOCK_STEP_NS ends the drain (stamps from before
+ * the step cannot be compared any more; delivering a stale frame beats dropping live ones).
+ * A frame without a stamp counts as fresh.
+ */
+static bool sc_rx_fresh_locked(struct sc_data *d, uint64_t rx_real_ns)
 {
-	can_filter_table_deliver(d->dev, d->filters, SC_MAX_FILTERS, &d->rx_lock, frame);
+	uint64_t mono;
+	int64_t offset;
+
+	if (!d->draining) {
+		return true;
+	}
+	if (rx_real_ns == 0U || rx_real_ns >= d->start_real_ns) {
+		d->draining = false;
+		return true;
+	}
+	/*
+	 * Monotonic first, then wall clock: a preemption between the two reads can only make the
+	 * offset look larger, never fake a step back (can_start() reads them the other way round).
+	 */
+	mono = socketcan_host_mono_ns();
+	offset = (int64_t)(socketcan_host_real_ns() - mono);
+
+	if (offset < d->start_offset_ns - SC_CLOCK_STEP_NS) {
+		LOG_WRN("%s (%s): wall clock stepped back, cannot tell old frames from new ones",
+			d->dev->name, d->ifname);
+		d->draining = false;
+		return true;
+	}
+
+	return false;
 }
 
-static void sc_on_echo(struct sc_data *d, const struct can_frame *frame)
+/*
+ * Delivers a received frame to the filters if the controller is started and the frame arrived
+ * after the start. rx_lock is held from the decision to the end of the callbacks: can_stop()
+ * takes it once after clearing started, so no callback runs after can_stop() returns.
+ */
+static void sc_deliver(struct sc_data *d, const struct can_frame *frame, uint64_t rx_real_ns)
+{
+	bool deliver;
+
+	k_mutex_lock(&d->rx_lock, K_FOREVER);
+	k_mutex_lock(&d->lock, K_FOREVER);
+	deliver = sc_rx_fresh_locked(d, rx_real_ns) && d->common.started;
+	k_mutex_unlock(&d->lock);
+	if (deliver) {
+		can_filter_table_deliver(d->dev, d->filters, SC_MAX_FILTERS, &d->rx_lock, frame);
+	}
+	k_mutex_unlock(&d->rx_lock);
+}
+
+static void sc_on_echo(struct sc_data *d, const struct can_frame *frame, uint64_t rx_real_ns)
 {
 	struct sc_tx tx;
 	bool have;
 	bool loopback;
 
+	/* The echo completes the oldest frame in flight whenever it comes, also while stopped. */
 	k_mutex_lock(&d->lock, K_FOREVER);
 	if (d->stale_echoes > 0U) {
 		d->stale_echoes--;
@@ -232,12 +317,13 @@ static void sc_on_echo(struct sc_data *d, const struct can_frame *frame)
 	} else {
 		have = sc_pop_locked(d, &tx);
 	}
-	loopback = d->common.started && (d->common.mode & CAN_MODE_LOOPBACK) != 0U;
+	loopback = (d->common.mode & CAN_MODE_LOOPBACK) != 0U;
 	k_mutex_unlock(&d->lock);
 
 	k_sem_give(&d->echo_seen);
 	if (loopback) {
-		sc_deliver(d, frame);
+		/* the mode only changes while stopped; sc_deliver() checks started */
+		sc_deliver(d, frame, rx_real_ns);
 	}
 	if (have) {
 		k_sem_give(&d->tx_slots);
@@ -247,7 +333,8 @@ static void sc_on_echo(struct sc_data *d, const struct can_frame *frame)
 	}
 }
 
-static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_frame *hf)
+static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_frame *hf,
+			      uint64_t rx_real_ns)
 {
 	struct socketcan_host_error err;
 	struct sc_tx aborted[SC_TXQ_SIZE];
@@ -261,6 +348,11 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 	socketcan_host_decode_error(hf, &err);
 
 	k_mutex_lock(&d->lock, K_FOREVER);
+	if (!sc_rx_fresh_locked(d, rx_real_ns)) {
+		/* news from before the last can_start(), which reset the state */
+		k_mutex_unlock(&d->lock);
+		return;
+	}
 	if (err.has_counters) {
 		d->err_cnt.tx_err_cnt = err.tx_err_cnt;
 		d->err_cnt.rx_err_cnt = err.rx_err_cnt;
@@ -310,12 +402,13 @@ static void sc_rx_thread(void *p1, void *p2, void *p3)
 	struct sc_data *d = p1;
 	struct socketcan_host_frame hf;
 	struct can_frame frame;
+	uint64_t rx_real_ns;
 	uint64_t rx_ns;
 	bool own;
 	int last_err = 0;
 
 	for (;;) {
-		int rc = socketcan_host_recv(d->fd, &hf, &rx_ns, &own);
+		int rc = socketcan_host_recv(d->fd, &hf, &rx_real_ns, &rx_ns, &own);
 
 		if (rc == -EINTR) {
 			continue;
@@ -337,7 +430,7 @@ static void sc_rx_thread(void *p1, void *p2, void *p3)
 		last_err = 0;
 
 		if ((hf.flags & SOCKETCAN_HOST_F_ERR) != 0U) {
-			sc_on_error_frame(d, &hf);
+			sc_on_error_frame(d, &hf, rx_real_ns);
 			continue;
 		}
 
@@ -353,10 +446,9 @@ static void sc_rx_thread(void *p1, void *p2, void *p3)
 #endif
 
 		if (own) {
-			sc_on_echo(d, &frame);
-		} else if (d->common.started) {
-			/* started is a single aligned word: a stale read only delays a stop */
-			sc_deliver(d, &frame);
+			sc_on_echo(d, &frame, rx_real_ns);
+		} else {
+			sc_deliver(d, &frame, rx_real_ns);
 		}
 	}
 }
@@ -385,6 +477,11 @@ static int sc_start(const struct device *dev)
 		d->state = CAN_STATE_ERROR_ACTIVE;
 		d->err_cnt.tx_err_cnt = 0U;
 		d->err_cnt.rx_err_cnt = 0U;
+		/* Frames the kernel stamps before this instant arrived while we were stopped. */
+		d->start_real_ns = socketcan_host_real_ns();
+		/* wall clock first: the offset can only come out smaller (sc_rx_fresh_locked()) */
+		d->start_offset_ns = (int64_t)(d->start_real_ns - socketcan_host_mono_ns());
+		d->draining = true;
 		d->common.started = true;
 	}
 	k_mutex_unlock(&d->lock);
@@ -392,11 +489,19 @@ static int sc_start(const struct device *dev)
 	return rc;
 }
 
+/*
+ * Stopping cannot abort what the kernel already holds: a frame written to the socket goes out
+ * whatever we do, so reporting it aborted (-ENETDOWN) would be a lie. can_stop() refuses new
+ * frames (and those still waiting in can_send() for room) with -ENETDOWN, then waits for the
+ * echoes of the frames in flight; their callbacks get 0 as they are confirmed. Frames still
+ * queued after CONFIG_CAN_SOCKETCAN_STOP_DRAIN_MS (a bus without acknowledgement) complete
+ * when the interface sends them, possibly after can_stop() returned.
+ */
 static int sc_stop(const struct device *dev)
 {
 	struct sc_data *d = sc_data(dev);
-	struct sc_tx aborted[SC_TXQ_SIZE];
-	int n;
+	k_timepoint_t end = sys_timepoint_calc(K_MSEC(CONFIG_CAN_SOCKETCAN_STOP_DRAIN_MS));
+	uint16_t in_flight;
 
 	k_mutex_lock(&d->lock, K_FOREVER);
 	if (!d->common.started) {
@@ -404,9 +509,30 @@ static int sc_stop(const struct device *dev)
 		return -EALREADY;
 	}
 	d->common.started = false;
-	n = sc_abort_locked(d, aborted);
 	k_mutex_unlock(&d->lock);
-	sc_run_aborted(d, aborted, n, -ENETDOWN);
+
+	/* Barrier: a delivery that saw started before we cleared it ends before we return. */
+	k_mutex_lock(&d->rx_lock, K_FOREVER);
+	k_mutex_unlock(&d->rx_lock);
+
+	/* Only the receive thread reads echoes: from its callbacks, do not wait for them. */
+	if (k_current_get() == &d->rx_thread) {
+		return 0;
+	}
+	for (;;) {
+		k_mutex_lock(&d->lock, K_FOREVER);
+		in_flight = d->count;
+		k_mutex_unlock(&d->lock);
+		if (in_flight == 0U) {
+			break;
+		}
+		if (k_sem_take(&d->tx_idle, sys_timepoint_timeout(end)) != 0) {
+			LOG_WRN("%s (%s): %u frames still in the kernel's queue after can_stop(); "
+				"they complete when sent",
+				dev->name, d->ifname, in_flight);
+			break;
+		}
+	}
 
 	return 0;
 }
@@ -647,6 +773,7 @@ static int sc_init(const struct device *dev)
 	k_mutex_init(&d->rx_lock);
 	k_sem_init(&d->tx_slots, SC_TXQ_SIZE, SC_TXQ_SIZE);
 	k_sem_init(&d->echo_seen, 0, 1);
+	k_sem_init(&d->tx_idle, 0, 1);
 
 	sc_resolve_ifname(cfg->index, d->ifname);
 	if (d->ifname[0] == '\0') {

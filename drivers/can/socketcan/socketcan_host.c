@@ -155,18 +155,21 @@ uint64_t socketcan_host_mono_ns(void)
 	return (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
 }
 
-/* The kernel stamps CLOCK_REALTIME; map it onto CLOCK_MONOTONIC through the current offset. */
-static uint64_t realtime_to_mono_ns(const struct timespec *rt)
+uint64_t socketcan_host_real_ns(void)
 {
-	struct timespec now_rt;
-	int64_t rt_ns = (int64_t)rt->tv_sec * 1000000000LL + rt->tv_nsec;
-	int64_t now_rt_ns;
-	uint64_t now_mono = socketcan_host_mono_ns();
-	int64_t age;
+	struct timespec ts;
 
-	clock_gettime(CLOCK_REALTIME, &now_rt);
-	now_rt_ns = (int64_t)now_rt.tv_sec * 1000000000LL + now_rt.tv_nsec;
-	age = now_rt_ns - rt_ns;
+	clock_gettime(CLOCK_REALTIME, &ts);
+
+	return (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
+}
+
+/* The kernel stamps CLOCK_REALTIME; map it onto CLOCK_MONOTONIC through the current offset. */
+static uint64_t realtime_to_mono_ns(uint64_t rt_ns)
+{
+	uint64_t now_mono = socketcan_host_mono_ns();
+	int64_t age = (int64_t)(socketcan_host_real_ns() - rt_ns);
+
 	if (age < 0 || (uint64_t)age > now_mono) {
 		/* clock step between stamp and now: the best estimate is "just now" */
 		age = 0;
@@ -175,7 +178,8 @@ static uint64_t realtime_to_mono_ns(const struct timespec *rt)
 	return now_mono - (uint64_t)age;
 }
 
-int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_mono_ns, bool *own)
+int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_real_ns,
+			uint64_t *rx_mono_ns, bool *own)
 {
 	struct can_frame cf;
 	struct iovec iov = {.iov_base = &cf, .iov_len = sizeof(cf)};
@@ -198,13 +202,15 @@ int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx
 		return -EIO; /* CAN FD frames are not enabled on the socket */
 	}
 
+	*rx_real_ns = 0U;
 	*rx_mono_ns = 0U;
 	for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c != NULL; c = CMSG_NXTHDR(&msg, c)) {
 		if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
 			struct timespec ts;
 
 			memcpy(&ts, CMSG_DATA(c), sizeof(ts));
-			*rx_mono_ns = realtime_to_mono_ns(&ts);
+			*rx_real_ns = (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
+			*rx_mono_ns = realtime_to_mono_ns(*rx_real_ns);
 		}
 	}
 	*own = (msg.msg_flags & MSG_CONFIRM) != 0;

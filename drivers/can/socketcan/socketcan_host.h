@@ -64,12 +64,13 @@ int socketcan_host_is_up(const char *ifname);
 int socketcan_host_send(int fd, const struct socketcan_host_frame *frame);
 
 /*
- * Block until a frame arrives. @p rx_mono_ns gets the kernel's receive time on
- * CLOCK_MONOTONIC (0 if the kernel gave none), @p own tells whether it is the echo of a frame
- * sent through this socket. -EINTR if interrupted by a signal.
+ * Block until a frame arrives. @p rx_real_ns gets the kernel's receive time as the kernel
+ * stamped it (CLOCK_REALTIME, comparable with socketcan_host_real_ns()), @p rx_mono_ns the
+ * same instant mapped onto CLOCK_MONOTONIC (both 0 if the kernel gave none), @p own tells
+ * whether it is the echo of a frame sent through this socket. -EINTR if interrupted by a signal.
  */
-int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_mono_ns,
-			bool *own);
+int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_real_ns,
+			uint64_t *rx_mono_ns, bool *own);
 
 /* Decode an error frame (flags has SOCKETCAN_HOST_F_ERR). */
 void socketcan_host_decode_error(const struct socketcan_host_frame *frame,
@@ -80,5 +81,8 @@ int socketcan_host_send_state(int fd, enum socketcan_host_state state);
 
 /* CLOCK_MONOTONIC now, in nanoseconds. */
 uint64_t socketcan_host_mono_ns(void);
+
+/* CLOCK_REALTIME now, in nanoseconds: the clock of the kernel's receive stamps. */
+uint64_t socketcan_host_real_ns(void);
 
 #endif /* SAFELINE_DRIVERS_CAN_SOCKETCAN_HOST_H_ */

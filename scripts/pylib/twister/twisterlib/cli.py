@@ -13,7 +13,16 @@ from . import statuses as st
 from .boards import load_platforms
 from .build import BuildOptions
 from .instance import TestInstance
-from .plan import PlanError, Selection, discover, display_path, make_plan, select_scenarios
+from .plan import (
+    PlanError,
+    Selection,
+    command_line_sanitizers,
+    discover,
+    display_path,
+    make_plan,
+    sanitizer_conflict,
+    select_scenarios,
+)
 from .runner import RunOptions, Runner, default_jobs
 
 REPO_ROOT = Path(__file__).resolve().parents[4]
@@ -175,6 +184,12 @@ def main(argv: list[str] | None = None) -> int:
         log.raw("\n".join(f" - {n}" for n in names) + f"\n{len(names)} total.")
         return 1 if errors else 0
 
+    wanted = (("ASAN", args.enable_asan), ("UBSAN", args.enable_ubsan), ("TSAN", args.enable_tsan))
+    sanitizers = [name for name, on in wanted if on]
+    conflict = sanitizer_conflict(command_line_sanitizers(sanitizers, args.extra_args))
+    if conflict:
+        log.error(f"{conflict}: the command line asks for both")
+        return 2
     sel = Selection(
         platforms=args.platform,
         all_platforms=args.all,
@@ -183,6 +198,8 @@ def main(argv: list[str] | None = None) -> int:
         exclude_tags=args.exclude_tag,
         enable_slow=args.enable_slow,
         build_only=args.build_only,
+        sanitizers=sanitizers,
+        extra_args=args.extra_args,
     )
     outdir = args.outdir
     try:
@@ -209,8 +226,6 @@ def main(argv: list[str] | None = None) -> int:
         log.info(f"dry run: {report_dir / 'testplan.json'}")
         return 1 if errors else 0
 
-    wanted = (("ASAN", args.enable_asan), ("UBSAN", args.enable_ubsan), ("TSAN", args.enable_tsan))
-    sanitizers = [name for name, on in wanted if on]
     opts = RunOptions(
         base=REPO_ROOT,
         outdir=outdir,

@@ -121,6 +121,116 @@ class Selection:
     exclude_tags: list[str] = None  # -e
     enable_slow: bool = False  # -S
     build_only: bool = False  # -b
+    sanitizers: list = None  # --enable-asan/-ubsan/-tsan: "ASAN", "UBSAN", "TSAN"
+    extra_args: list = None  # -x values
+
+
+# Sanitizers that cannot share an image (Kconfig: TSAN depends on !ASAN; GCC and Clang refuse
+# -fsanitize=address,thread). UBSan goes with either.
+SANITIZER_CONFLICTS = (("TSAN", "ASAN"),)
+_SANITIZER_NAMES = {"ASAN": "ASan", "UBSAN": "UBSan", "TSAN": "TSan"}
+
+
+def _cache_assignment(arg: str) -> tuple[str, str] | None:
+    """"VAR=value", "-DVAR=value" or "-DVAR:TYPE=value" -> (VAR, value)."""
+    arg = arg[2:] if arg.startswith("-D") else arg
+    if "=" not in arg:
+        return None
+    name, value = arg.split("=", 1)
+    return name.split(":", 1)[0], value
+
+
+def _read_fragment(path: Path) -> dict[str, str]:
+    """CONFIG_* assignments of a Kconfig fragment ("# CONFIG_X is not set" reads n)."""
+    values: dict[str, str] = {}
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return values
+    for line in text.splitlines():
+        line = line.strip()
+        if line.startswith("# CONFIG_") and line.endswith(" is not set"):
+            values[line[2:-len(" is not set")]] = "n"
+        elif line.startswith("CONFIG_") and "=" in line:
+            name, value = line.split("=", 1)
+            values[name.strip()] = value.strip().strip('"')
+    return values
+
+
+def sanitizer_settings(sc: Scenario, plat: Platform, sel: Selection) -> dict[str, str]:
+    """The sanitizers an instance's build would enable: {"ASAN": "where it comes from"}.
+
+    Follows the Kconfig merge of cmake/kconfig.cmake (board defconfig, CONF_FILE or
+    prj[_<board>].conf, boards/<board>.conf, EXTRA_CONF_FILE, then the -DCONFIG_* values, the
+    last assignment winning) over the -D arguments that build.cmake_command() passes, in its
+    order: extra_conf_files, extra_args, extra_configs, --enable-*, -x.
+    """
+    cache: dict[str, tuple[str, str]] = {}  # -D variable -> (value, origin)
+    if sc.get("extra_conf_files"):
+        cache["EXTRA_CONF_FILE"] = (";".join(sc.get("extra_conf_files")), "extra_conf_files")
+    assignments = [("extra_args", a) for a in sc.get("extra_args") or []]
+    assignments += [("extra_configs", a) for a in sc.get("extra_configs") or []]
+    assignments += [(f"--enable-{s.lower()}", f"CONFIG_{s}=y") for s in sel.sanitizers or []]
+    assignments += [("-x", a) for a in sel.extra_args or []]
+    for origin, arg in assignments:
+        kv = _cache_assignment(arg)
+        if kv:
+            cache[kv[0]] = (kv[1], origin)
+
+    def files(var: str) -> list[Path] | None:
+        value = cache[var][0] if var in cache else os.environ.get(var)
+        if value is None:
+            return None
+        return [sc.source_dir / f for f in value.replace(";", " ").split()]
+
+    fragments = []
+    if plat.path is not None:
+        fragments.append(plat.path.parent / f"{plat.identifier}_defconfig")
+    conf = files("CONF_FILE")
+    if conf is None:
+        board_prj = sc.source_dir / f"prj_{plat.identifier}.conf"
+        conf = [board_prj if board_prj.exists() else sc.source_dir / "prj.conf"]
+    fragments += conf
+    fragments.append(sc.source_dir / "boards" / f"{plat.identifier}.conf")
+    fragments += files("EXTRA_CONF_FILE") or []
+
+    config: dict[str, tuple[str, str]] = {}
+    for frag in fragments:
+        for name, value in _read_fragment(frag).items():
+            config[name] = (value, frag.name)
+    for name, (value, origin) in cache.items():
+        if name.startswith("CONFIG_"):
+            config[name] = (value, origin)
+    return {
+        s: config[f"CONFIG_{s}"][1]
+        for s in _SANITIZER_NAMES
+        if config.get(f"CONFIG_{s}", ("n", ""))[0] == "y"
+    }
+
+
+def command_line_sanitizers(sanitizers: list, extra_args: list) -> dict[str, str]:
+    """The sanitizers the command line alone enables (--enable-*, then -x CONFIG_*SAN=...)."""
+    enabled = {s: f"--enable-{s.lower()}" for s in sanitizers or []}
+    for arg in extra_args or []:
+        kv = _cache_assignment(arg)
+        if kv and kv[0].startswith("CONFIG_") and kv[0][len("CONFIG_"):] in _SANITIZER_NAMES:
+            name = kv[0][len("CONFIG_"):]
+            if kv[1] == "y":
+                enabled[name] = "-x"
+            else:
+                enabled.pop(name, None)
+    return enabled
+
+
+def sanitizer_conflict(enabled: dict[str, str]) -> str | None:
+    """Why these sanitizers cannot be built together, or None."""
+    for a, b in SANITIZER_CONFLICTS:
+        if a in enabled and b in enabled:
+            return (
+                f"{_SANITIZER_NAMES[a]} and {_SANITIZER_NAMES[b]} cannot be combined "
+                f"(CONFIG_{b}=y from {enabled[b]}, CONFIG_{a}=y from {enabled[a]})"
+            )
+    return None
 
 
 def platforms_for(sc: Scenario, platforms: dict[str, Platform], sel: Selection) -> list[Platform]:
@@ -173,6 +283,9 @@ def static_filter(sc: Scenario, plat: Platform, sel: Selection) -> tuple[str, st
         return st.FILTERED, "not enough flash (min_flash)"
     if sc.get("slow") and not sel.enable_slow:
         return st.FILTERED, "slow scenario (run with -S)"
+    conflict = sanitizer_conflict(sanitizer_settings(sc, plat, sel))
+    if conflict:
+        return st.FILTERED, conflict
     if sc.get("skip"):
         return st.SKIPPED, "skip: true"
     return None

@@ -411,6 +411,131 @@ ZTEST(can_api, test_stop_start)
 	expect_sentinel(&peer_rxq);
 }
 
+/*
+ * Stress for the race between can_start() and frames that reached the controller while it was
+ * stopped: each cycle stops the dut, lets the peer send 3 frames (complete: the peer saw them
+ * on the bus), starts the dut and sends a sentinel. Everything the dut receives before the
+ * sentinel was sent while it was stopped and must not be delivered.
+ */
+#define STOPPED_CYCLES 300
+#define STOPPED_FRAMES 3
+#define STOPPED_ID     0x112U
+
+ZTEST(can_api, test_no_reception_while_stopped_stress)
+{
+	int leaked = 0;
+	int first_leak = -1;
+
+	add_filter_msgq(dut, &dut_rxq, STOPPED_ID, CAN_STD_ID_MASK, 0);
+	add_filter_msgq(dut, &dut_rxq, SENTINEL_ID, CAN_STD_ID_MASK, 0);
+	for (int cycle = 0; cycle < STOPPED_CYCLES; cycle++) {
+		struct can_frame got;
+
+		zassert_ok(can_stop(dut));
+		for (int i = 0; i < STOPPED_FRAMES; i++) {
+			const struct can_frame f =
+				frame_of(STOPPED_ID, 0, 3,
+					 (const uint8_t[]){(uint8_t)cycle, (uint8_t)(cycle >> 8),
+							   (uint8_t)i});
+
+			send_ok(peer, &f);
+		}
+		zassert_ok(can_start(dut));
+		send_sentinel(peer);
+		for (;;) {
+			zassert_ok(k_msgq_get(&dut_rxq, &got, WAIT),
+				   "cycle %d: the sentinel sent after can_start() is missing",
+				   cycle);
+			if (got.id == SENTINEL_ID) {
+				break;
+			}
+			if (first_leak < 0) {
+				first_leak = cycle;
+			}
+			leaked++;
+		}
+	}
+	zassert_equal(leaked, 0,
+		      "%d of %d frames sent while the controller was stopped were delivered after "
+		      "can_start() (first in cycle %d)",
+		      leaked, STOPPED_CYCLES * STOPPED_FRAMES, first_leak);
+}
+
+/*
+ * can_stop() with frames in flight: a frame whose callback said -ENETDOWN (aborted) must not
+ * appear on the bus, and one that completed with 0 must. Each cycle queues a few frames,
+ * stops at once, restarts, and sends a sentinel: the bus keeps order, so every frame that went
+ * out arrives at the peer before it.
+ */
+#define ABORT_CYCLES 50
+#define ABORT_FRAMES 4
+#define ABORT_ID     0x113U
+
+static struct k_sem abort_sem;
+static int abort_status[ABORT_FRAMES];
+
+static void abort_cb(const struct device *dev, int error, void *user_data)
+{
+	abort_status[(int)(intptr_t)user_data] = error;
+	k_sem_give(&abort_sem);
+}
+
+ZTEST(can_api, test_stop_reports_in_flight_frames_truthfully)
+{
+	int aborted_but_sent = 0;
+	int completed_but_lost = 0;
+	int n_aborted = 0;
+
+	add_filter_msgq(peer, &peer_rxq, ABORT_ID, CAN_STD_ID_MASK, 0);
+	for (int cycle = 0; cycle < ABORT_CYCLES; cycle++) {
+		bool seen[ABORT_FRAMES] = {false};
+		struct can_frame got;
+
+		k_sem_init(&abort_sem, 0, ABORT_FRAMES);
+		for (int i = 0; i < ABORT_FRAMES; i++) {
+			const struct can_frame f = frame_of(
+				ABORT_ID, 0, 2, (const uint8_t[]){(uint8_t)cycle, (uint8_t)i});
+
+			abort_status[i] = 1;
+			zassert_ok(can_send(dut, &f, WAIT, abort_cb, (void *)(intptr_t)i));
+		}
+		zassert_ok(can_stop(dut));
+		for (int i = 0; i < ABORT_FRAMES; i++) {
+			zassert_ok(k_sem_take(&abort_sem, WAIT),
+				   "cycle %d: a TX callback is missing", cycle);
+		}
+		zassert_ok(can_start(dut));
+		send_sentinel(dut);
+		for (;;) {
+			zassert_ok(k_msgq_get(&peer_rxq, &got, WAIT), "cycle %d: no sentinel",
+				   cycle);
+			if (got.id == SENTINEL_ID) {
+				break;
+			}
+			zassert_equal(got.data[0], (uint8_t)cycle, "a frame of another cycle");
+			zassert_true(got.data[1] < ABORT_FRAMES);
+			seen[got.data[1]] = true;
+		}
+		for (int i = 0; i < ABORT_FRAMES; i++) {
+			zassert_true(abort_status[i] == 0 || abort_status[i] == -ENETDOWN,
+				     "cycle %d frame %d completed with %d", cycle, i,
+				     abort_status[i]);
+			if (abort_status[i] == -ENETDOWN) {
+				n_aborted++;
+				aborted_but_sent += seen[i] ? 1 : 0;
+			} else {
+				completed_but_lost += seen[i] ? 0 : 1;
+			}
+		}
+	}
+	TC_PRINT("%d of %d frames aborted by can_stop()\n", n_aborted, ABORT_CYCLES * ABORT_FRAMES);
+	zassert_equal(aborted_but_sent, 0,
+		      "%d frames reported aborted (-ENETDOWN) by can_stop() went out on the bus",
+		      aborted_but_sent);
+	zassert_equal(completed_but_lost, 0, "%d frames reported sent never reached the bus",
+		      completed_but_lost);
+}
+
 ZTEST(can_api, test_invalid_arguments)
 {
 	struct can_frame f = frame_of(0x800, 0, 0, NULL);
