@@ -33,6 +33,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <canopen/event.h>
 #include <canopen/line.h>
 #include <canopen/nmt.h>
 
@@ -83,6 +84,8 @@ enum co_mgr_status {
 enum co_mgr_step {
 	CO_MGR_STEP_IDLE,
 	CO_MGR_STEP_ASSIGNED,
+	/** Wait for the boot-up after the master reset the slave (at most BOOTUP_WAIT). */
+	CO_MGR_STEP_BOOTUP,
 	CO_MGR_STEP_BOOT_ALLOWED,
 	CO_MGR_STEP_DEVTYPE,
 	CO_MGR_STEP_VENDOR,
@@ -218,6 +221,7 @@ struct co_mgr_slave {
 	struct co_timer ec_timer; /* heartbeat consumer / node guarding */
 	uint64_t started_us;
 	uint64_t finished_us;
+	uint64_t reset_us; /* the master's last reset of the slave went out */
 	uint32_t ident[5]; /* 1000h, 1018h:01..04 as read */
 	uint8_t buf[4];    /* upload buffer */
 	uint8_t load[4];   /* restore signature "load" */
@@ -233,6 +237,8 @@ struct co_mgr_slave {
 	uint16_t attempts;
 	uint16_t guard_ms;
 	uint16_t hb_ms;
+	uint16_t xfer_index; /* object of the boot's SDO transfer */
+	uint8_t xfer_sub;
 	uint8_t id; /* 0: slot free */
 	uint8_t slot;
 	uint8_t step;
@@ -259,6 +265,8 @@ struct co_mgr_slave {
 	bool wait_reboot;    /* after an error-handler reset, waiting for the boot-up */
 	bool start_deferred; /* booted while a mandatory slave was still booting */
 	bool cfg_wait;       /* DOWNLOAD step waiting for a configuration job slot */
+	bool await_bootup;   /* reset by the master, no boot-up seen since */
+	bool held;           /* an attempt waits for the master to leave Stopped */
 };
 
 struct co_mgr_nmt_cmd {
@@ -270,6 +278,7 @@ struct co_mgr_nmt_cmd {
 struct co_mgr {
 	struct co_node *node;
 	struct co_rx ec_rx;          /* 700h..77Fh: boot-up, heartbeat, guarding replies */
+	struct co_listener listener; /* our own NMT changes: abort the boot transfers first */
 	struct co_timer nmt_timer;   /* inhibit time 102Ah */
 	struct co_timer start_timer; /* deferred startup steps */
 	struct co_timer boot_timer;  /* 1F89h */

@@ -14,6 +14,8 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
+#include <canopen/sdo_abort.h>
+
 #include "mgr_internal.h"
 
 LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
@@ -75,12 +77,37 @@ static void slaves_reset(struct co_mgr *m)
 		s->start_deferred = false;
 		s->tried = false;
 		s->cfg_wait = false;
+		s->await_bootup = false;
+		s->held = false;
 		s->status = CO_MGR_ST_NONE;
 		s->last_status = CO_MGR_ST_NONE;
 		s->rep_state = 0U;
 		s->step = CO_MGR_STEP_IDLE;
 		s->attempts = 0U;
 	}
+}
+
+/*
+ * The master is about to leave the states in which SDO runs (a Stop, or a reset, of its own
+ * or from another device): abort the boot transfers on the bus while it may still send them
+ * (CiA 301: no SDO in Stopped), so the slaves' servers do not wait for a timeout.
+ */
+static int mgr_event(struct co_node *node, const struct co_event *ev, void *user_data)
+{
+	struct co_mgr *m = user_data;
+	enum co_nmt_state st = co_node_nmt_state(node);
+
+	if (st != CO_NMT_PRE_OPERATIONAL && st != CO_NMT_OPERATIONAL) {
+		return 0;
+	}
+	if (ev->type == CO_EV_NMT_VETO &&
+	    (ev->nmt.to == CO_NMT_PRE_OPERATIONAL || ev->nmt.to == CO_NMT_OPERATIONAL)) {
+		return 0;
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+		co_mgr_boot_abort_sdo(&m->slaves[i], CO_SDO_AB_DATA_DEV_STATE);
+	}
+	return 0;
 }
 
 static int mgr_init(struct co_node *node)
@@ -106,6 +133,11 @@ static int mgr_init(struct co_node *node)
 	co_rx_init(&m->ec_rx, CO_NMT_EC_COB_ID, co_mgr_ec_rx, &node->lock, m);
 	m->ec_rx.mask = 0x780U;
 	if (co_node_rx_register(m->node, CO_LINE_DEFAULT, &m->ec_rx) != 0) {
+		return -ENOSPC;
+	}
+	co_listener_init(&m->listener, "mgr",
+			 CO_EV_BIT(CO_EV_NMT_VETO) | CO_EV_BIT(CO_EV_NMT_RESET), mgr_event, m);
+	if (co_node_listener_add(node, &m->listener) != 0) {
 		return -ENOSPC;
 	}
 	return co_mgr_od_hooks_register(m);
@@ -147,27 +179,30 @@ static void mgr_set_state(struct co_node *node, enum co_nmt_state from, enum co_
 			co_timer_stop(&m->slaves[i].ec_timer);
 			m->slaves[i].booting = false;
 			m->slaves[i].sdo_pending = false;
+			m->slaves[i].held = false;
 		}
 		break;
 	case CO_NMT_PRE_OPERATIONAL:
-		if (m->boot_pending) {
+	case CO_NMT_OPERATIONAL:
+		if (to == CO_NMT_PRE_OPERATIONAL && m->boot_pending) {
 			/* Run the startup after the boot-up message, from the line thread. */
 			m->boot_pending = false;
 			m->phase = PH_BEGIN;
 			co_node_timer_start(m->node, &m->start_timer, co_mgr_now(m));
 		}
+		/* Back from Stopped: the attempts cut or held there start now. */
+		for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+			co_mgr_boot_resume(&m->slaves[i]);
+		}
 		break;
 	case CO_NMT_STOPPED:
-		/* Boots stop with the SDO clients; supervision goes on. */
+		/*
+		 * Boots stop with the SDO clients; supervision goes on. Each running attempt ends
+		 * (B, indicated) and starts again when the master runs again, so the startup
+		 * always ends (doc/mgr.md, "Decisions").
+		 */
 		for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
-			struct co_mgr_slave *s = &m->slaves[i];
-
-			if (s->booting) {
-				s->booting = false;
-				s->sdo_pending = false;
-				s->step = CO_MGR_STEP_IDLE;
-				co_timer_stop(&s->timer);
-			}
+			co_mgr_boot_stopped(&m->slaves[i]);
 		}
 		break;
 	default:

@@ -85,6 +85,8 @@ static uint8_t upload(struct co_mgr_slave *s, uint16_t index, uint8_t sub)
 
 	memset(s->buf, 0, sizeof(s->buf));
 	s->sdo_pending = true;
+	s->xfer_index = index;
+	s->xfer_sub = sub;
 	err = co_sdo_cli_upload_req(co_mgr_cli(s), index, sub, s->buf, sizeof(s->buf),
 				    CO_SDO_CLI_AUTO, CONFIG_CANOPEN_MGR_SDO_TIMEOUT, sdo_con, s);
 	if (err != 0) {
@@ -100,6 +102,8 @@ static uint8_t download(struct co_mgr_slave *s, uint16_t index, uint8_t sub, con
 	int err;
 
 	s->sdo_pending = true;
+	s->xfer_index = index;
+	s->xfer_sub = sub;
 	err = co_sdo_cli_download_req(co_mgr_cli(s), index, sub, data, len, CO_SDO_CLI_AUTO,
 				      CONFIG_CANOPEN_MGR_SDO_TIMEOUT, sdo_con, s);
 	if (err != 0) {
@@ -119,6 +123,42 @@ static uint8_t st_assigned(struct co_mgr_slave *s)
 	if ((as & AS_SLAVE) == 0U) {
 		return fail(s, CO_MGR_ST_A, IDX_ASSIGN, s->id, AS_SLAVE, as, 0U);
 	}
+	return CO_MGR_STEP_BOOTUP;
+}
+
+/*
+ * The master reset the slave (the startup's Reset Communication, 302-2 §3.1): its SDO server
+ * is back with its boot-up, and a request sent before is lost (a timeout of seconds). Wait
+ * for the boot-up, at most CONFIG_CANOPEN_MGR_BOOTUP_WAIT after the reset went out.
+ */
+static uint8_t st_bootup(struct co_mgr_slave *s)
+{
+	uint64_t until = s->reset_us + MS_US(CONFIG_CANOPEN_MGR_BOOTUP_WAIT);
+
+	if (!s->await_bootup || co_time_before_eq(until, co_mgr_now(s->mgr))) {
+		s->await_bootup = false;
+		return CO_MGR_STEP_BOOT_ALLOWED;
+	}
+	co_node_timer_start(s->mgr->node, &s->timer, until);
+	return NEXT_WAIT;
+}
+
+static uint8_t st_bootup_ec(struct co_mgr_slave *s, uint8_t byte)
+{
+	if (byte != 0U) {
+		/* A heartbeat of its old life, sent before the reset reached it. */
+		return NEXT_WAIT;
+	}
+	co_timer_stop(&s->timer);
+	return CO_MGR_STEP_BOOT_ALLOWED;
+}
+
+static uint8_t st_bootup_to(struct co_mgr_slave *s)
+{
+	/* No boot-up: go on, the first SDO transfer tells whether the slave is there. */
+	s->await_bootup = false;
+	LOG_DBG("%s: node %u: no boot-up %u ms after its reset", s->mgr->node->name, s->id,
+		CONFIG_CANOPEN_MGR_BOOTUP_WAIT);
 	return CO_MGR_STEP_BOOT_ALLOWED;
 }
 
@@ -447,6 +487,8 @@ static uint8_t st_download(struct co_mgr_slave *s)
 	}
 	s->cfg_wait = false;
 	s->sdo_pending = true;
+	s->xfer_index = 0x1F22U;
+	s->xfer_sub = s->id;
 	err = co_cfg_download_req(cfg, co_mgr_cli(s), s->id, cfg_con, s);
 	if (err == -ENOENT) {
 		s->sdo_pending = false;
@@ -576,6 +618,10 @@ static uint8_t st_start(struct co_mgr_slave *s)
 static const struct boot_state boot_table[CO_MGR_STEP_COUNT] = {
 	[CO_MGR_STEP_IDLE] = {.name = "IDLE"},
 	[CO_MGR_STEP_ASSIGNED] = {.name = "ASSIGNED", .enter = st_assigned},
+	[CO_MGR_STEP_BOOTUP] = {.name = "BOOTUP",
+				.enter = st_bootup,
+				.ec = st_bootup_ec,
+				.timeout = st_bootup_to},
 	[CO_MGR_STEP_BOOT_ALLOWED] = {.name = "BOOT_ALLOWED", .enter = st_boot_allowed},
 	[CO_MGR_STEP_DEVTYPE] = {.name = "DEVTYPE", .enter = st_devtype, .sdo = st_devtype_sdo},
 	[CO_MGR_STEP_VENDOR] = {.name = "VENDOR", .enter = st_ident, .sdo = st_ident_sdo},
@@ -702,8 +748,22 @@ void co_mgr_boot_ec(struct co_mgr_slave *s, uint8_t byte)
 /* --- Boot process (302-2 §3.3) -----------------------------------------------------------------
  */
 
+/* The master can run SDO transfers (CiA 301: not while Stopped or Initialising). */
+static bool master_runs(struct co_mgr *m)
+{
+	enum co_nmt_state st = co_node_nmt_state(m->node);
+
+	return st == CO_NMT_PRE_OPERATIONAL || st == CO_NMT_OPERATIONAL;
+}
+
 static void boot_attempt(struct co_mgr_slave *s)
 {
+	if (!master_runs(s->mgr)) {
+		/* Stopped: the attempt starts when the master runs again (co_mgr_boot_resume()). */
+		s->held = true;
+		return;
+	}
+	s->held = false;
 	s->booting = true;
 	s->attempts++;
 	s->status = CO_MGR_ST_NONE;
@@ -734,15 +794,18 @@ void co_mgr_boot_process_start(struct co_mgr_slave *s)
 
 void co_mgr_boot_expire(struct co_mgr_slave *s, uint64_t now_us)
 {
-	if (!s->booting && !co_timer_is_armed(&s->timer)) {
+	bool never_ran = s->held && !s->tried;
+
+	if (!s->booting && !s->held && !co_timer_is_armed(&s->timer)) {
 		return;
 	}
 	co_timer_stop(&s->timer);
+	s->held = false;
 	if (s->sdo_pending) {
 		s->sdo_pending = false;
 		(void)co_sdo_cli_abort_req(co_mgr_cli(s), CO_SDO_AB_TIMEOUT);
 	}
-	if (s->booting) {
+	if (s->booting || never_ran) {
 		(void)fail(s, CO_MGR_ST_B, IDX_BOOT_TIME, 0, co_mgr_od(s->mgr, IDX_BOOT_TIME, 0),
 			   0U, 0U);
 		s->booting = false;
@@ -750,6 +813,51 @@ void co_mgr_boot_expire(struct co_mgr_slave *s, uint64_t now_us)
 		s->step = CO_MGR_STEP_IDLE;
 		s->finished_us = now_us;
 		publish(s);
+	}
+}
+
+void co_mgr_boot_retry(struct co_mgr_slave *s)
+{
+	if (!master_runs(s->mgr)) {
+		s->held = true;
+		return;
+	}
+	co_mgr_arm(s, CONFIG_CANOPEN_MGR_RETRY_TIME);
+}
+
+void co_mgr_boot_abort_sdo(struct co_mgr_slave *s, uint32_t abort_code)
+{
+	/*
+	 * The confirmation still comes (line thread): if the master really leaves, the boot is
+	 * cancelled by then and it is ignored; if the change was refused, it ends the step.
+	 */
+	if (s->booting && s->sdo_pending && co_sdo_cli_busy(co_mgr_cli(s))) {
+		(void)co_sdo_cli_abort_req(co_mgr_cli(s), abort_code);
+	}
+}
+
+void co_mgr_boot_stopped(struct co_mgr_slave *s)
+{
+	bool xfer = s->sdo_pending;
+
+	if (!s->booting) {
+		return;
+	}
+	co_timer_stop(&s->timer);
+	s->sdo_pending = false;
+	/* An attempt that ended: B (retried), with the step and the transfer it was in. */
+	(void)fail(s, CO_MGR_ST_B, xfer ? s->xfer_index : 0U, xfer ? s->xfer_sub : 0U, 0U,
+		   CO_NMT_STOPPED, CO_SDO_AB_DATA_DEV_STATE);
+	s->held = true;
+	boot_end(s);
+}
+
+void co_mgr_boot_resume(struct co_mgr_slave *s)
+{
+	if (s->held && s->id != 0U) {
+		s->held = false;
+		/* From the line thread, after the SDO client confirmed the cut transfer. */
+		co_node_timer_start(s->mgr->node, &s->timer, co_mgr_now(s->mgr));
 	}
 }
 

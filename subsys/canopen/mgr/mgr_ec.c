@@ -210,6 +210,9 @@ void co_mgr_ec_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	byte = frame->data[0];
 	s = co_mgr_slot_find(m, id);
 	if (byte == 0U) {
+		if (s != NULL) {
+			s->await_bootup = false;
+		}
 		bootup_handler(m, id, s);
 		return;
 	}

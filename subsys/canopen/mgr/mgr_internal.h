@@ -166,6 +166,14 @@ void co_mgr_boot_process_start(struct co_mgr_slave *s);
 void co_mgr_boot_ec(struct co_mgr_slave *s, uint8_t byte);
 /* 1F89h expired while @p s had not booted: end its attempt with B, stop its retries. */
 void co_mgr_boot_expire(struct co_mgr_slave *s, uint64_t now_us);
+/* Retry after B in CONFIG_CANOPEN_MGR_RETRY_TIME; while the master is Stopped, when it runs. */
+void co_mgr_boot_retry(struct co_mgr_slave *s);
+/* The master is about to leave Pre-operational/Operational: abort the running SDO on the bus. */
+void co_mgr_boot_abort_sdo(struct co_mgr_slave *s, uint32_t abort_code);
+/* The master entered Stopped: a running attempt ends (B, indicated) and is held. */
+void co_mgr_boot_stopped(struct co_mgr_slave *s);
+/* The master runs again: start the held attempt (from the line thread). */
+void co_mgr_boot_resume(struct co_mgr_slave *s);
 /* Boot step timeouts, retries and the wait for a boot-up after the error handler. */
 void co_mgr_slave_timer_handler(struct co_timer *timer, uint64_t now_us);
 

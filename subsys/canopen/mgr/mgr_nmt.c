@@ -54,6 +54,22 @@ static void nmt_expect(struct co_mgr *m, uint8_t cs, uint8_t id)
 	}
 }
 
+/* A reset went out: the slave's SDO server is back with its boot-up (the boot waits for it). */
+static void nmt_reset_sent(struct co_mgr *m, uint8_t cs, uint8_t id, uint64_t now)
+{
+	if (cs != CO_NMT_CS_RESET_NODE && cs != CO_NMT_CS_RESET_COMMUNICATION) {
+		return;
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+		struct co_mgr_slave *s = &m->slaves[i];
+
+		if (s->id != 0U && (id == 0U || id == s->id)) {
+			s->await_bootup = true;
+			s->reset_us = now;
+		}
+	}
+}
+
 static void nmt_kick(struct co_mgr *m)
 {
 	struct co_node *node = m->node;
@@ -80,6 +96,7 @@ static void nmt_kick(struct co_mgr *m)
 		(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
 		m->nmt_next_us = now + inhibit_us;
 		nmt_expect(m, cmd.cs, cmd.id);
+		nmt_reset_sent(m, cmd.cs, cmd.id, now);
 		if (cmd.self) {
 			/* May reset us (the queue with it): nothing of ours is valid afterwards. */
 			(void)co_nmt_req(node, (enum co_nmt_cs)cmd.cs);

@@ -80,6 +80,21 @@ static void startup_check(struct co_mgr *m)
 	m->startup = CO_MGR_STARTUP_DONE;
 	m->phase = PH_NONE;
 	su = co_mgr_startup_obj(m);
+	if (co_node_nmt_state(m->node) == CO_NMT_STOPPED) {
+		/*
+		 * An NMT Stop (of another device, or our error handler's "stop all") ended the
+		 * boots: S5 and S6 are skipped, the master and the slaves stay as the command left
+		 * them. Slaves booted later are started one by one (doc/mgr.md, "Decisions").
+		 */
+		LOG_WRN("%s: NMT startup complete while Stopped: nobody started", m->node->name);
+		for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+			m->slaves[i].start_deferred = false;
+		}
+		if (m->startup_ind != NULL) {
+			m->startup_ind(m->node, CO_MGR_STARTUP_DONE, NULL, m->startup_user_data);
+		}
+		return;
+	}
 	LOG_INF("%s: NMT startup complete", m->node->name);
 	if ((su & SU_NO_SELF_OP) == 0U) {
 		(void)co_nmt_req(m->node, CO_NMT_CS_START);
@@ -122,13 +137,13 @@ void co_mgr_startup_boot_ended(struct co_mgr_slave *s, bool mandatory, uint64_t 
 		if (mandatory) {
 			if (s->status == CO_MGR_ST_B &&
 			    (bt == 0U || !co_time_before_eq(s->started_us + MS_US(bt), now))) {
-				co_mgr_arm(s, CONFIG_CANOPEN_MGR_RETRY_TIME);
+				co_mgr_boot_retry(s);
 			} else {
 				halt(m, &s->err);
 			}
 		} else if (s->status == CO_MGR_ST_B) {
 			/* Optional slaves are polled in the background (§10 #9). */
-			co_mgr_arm(s, CONFIG_CANOPEN_MGR_RETRY_TIME);
+			co_mgr_boot_retry(s);
 		}
 	}
 	startup_check(m);

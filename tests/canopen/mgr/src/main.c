@@ -62,9 +62,16 @@ struct fake {
 	bool stuck_toggle; /* answers RTRs without toggling */
 	uint8_t state;
 	uint8_t toggle;
-	uint16_t hb_ms;    /* 0: no heartbeat */
-	bool hb_mute;      /* hangs: no heartbeat until reset */
-	int dies_at_reset; /* silent from this reset on (count), 0: never */
+	uint16_t hb_ms;     /* 0: no heartbeat */
+	bool hb_mute;       /* hangs: no heartbeat until reset */
+	int dies_at_reset;  /* silent from this reset on (count), 0: never */
+	bool mute_sdo;      /* present (NMT, boot-up, guarding) but never answers SDO */
+	bool no_bootup;     /* comes back from a reset without a boot-up message */
+	uint64_t bootup_us; /* time it needs to come back from a reset, 0: LATENCY */
+	uint64_t up_at;     /* with bootup_us: ignores SDO requests before this time */
+	int rtr_skip;       /* guarding RTRs left unanswered first */
+	int n_aborts;       /* SDO abort frames received */
+	uint32_t last_abort;
 	uint64_t next_hb;
 	struct fake_obj obj[MAX_OBJ];
 	int n_obj;
@@ -166,15 +173,28 @@ static struct fake *fake_find(uint8_t id)
 	return NULL;
 }
 
-static void pend(uint32_t id, uint8_t dlc, const uint8_t *data)
+/* Queue a frame of a fake for time @p at (kept in time order, FIFO for equal times). */
+static void pend_at(uint32_t id, uint8_t dlc, const uint8_t *data, uint64_t at)
 {
 	struct can_frame f = {.id = id, .dlc = dlc};
+	int i = t.n_pend;
 
 	zassert_true(t.n_pend < MAX_PEND);
 	memcpy(f.data, data, dlc);
+	while (i > 0 && t.pend_at[i - 1] > at) {
+		t.pend[i] = t.pend[i - 1];
+		t.pend_at[i] = t.pend_at[i - 1];
+		i--;
+	}
+	t.pend_at[i] = at;
+	t.pend[i] = f;
+	t.n_pend++;
+}
+
+static void pend(uint32_t id, uint8_t dlc, const uint8_t *data)
+{
 	/* The fakes answer after a short bus and processing delay. */
-	t.pend_at[t.n_pend] = t.now + LATENCY;
-	t.pend[t.n_pend++] = f;
+	pend_at(id, dlc, data, t.now + LATENCY);
 }
 
 static void fake_ec(struct fake *f, uint8_t byte)
@@ -189,7 +209,13 @@ static void fake_sdo(struct fake *f, const struct can_frame *rq)
 	uint8_t r[8] = {0, rq->data[1], rq->data[2], sub};
 	uint8_t ccs = rq->data[0] >> 5;
 
-	if (!f->present) {
+	if (ccs == 4) {
+		/* An abort is never answered. */
+		f->n_aborts++;
+		f->last_abort = sys_get_le32(&rq->data[4]);
+		return;
+	}
+	if (!f->present || f->mute_sdo || t.now < f->up_at) {
 		return;
 	}
 	for (int i = 0; i < f->n_obj; i++) {
@@ -246,8 +272,15 @@ static void fake_nmt(struct fake *f, uint8_t cs)
 		}
 		f->state = 0x7f;
 		if (f->present) {
-			fake_ec(f, 0x00);
-			f->next_hb = t.now + (uint64_t)f->hb_ms * MS;
+			uint64_t back = t.now + (f->bootup_us != 0U ? f->bootup_us : LATENCY);
+			uint8_t bootup = 0x00;
+
+			/* A slave with its own boot time ignores SDO until it is back. */
+			f->up_at = f->bootup_us != 0U ? back : 0U;
+			if (!f->no_bootup) {
+				pend_at(0x700 + f->id, 1, &bootup, back);
+			}
+			f->next_hb = (f->bootup_us != 0U ? back : t.now) + (uint64_t)f->hb_ms * MS;
 		}
 		break;
 	default:
@@ -281,7 +314,9 @@ static int sink(struct co_line *line, const struct can_frame *frame, void *user_
 	if (frame->id > 0x700 && frame->id <= 0x77f && (frame->flags & CAN_FRAME_RTR) != 0U) {
 		struct fake *f = fake_find(frame->id - 0x700);
 
-		if (f != NULL && f->present && f->answer_rtr) {
+		if (f != NULL && f->present && f->answer_rtr && f->rtr_skip > 0) {
+			f->rtr_skip--;
+		} else if (f != NULL && f->present && f->answer_rtr) {
 			fake_ec(f, (uint8_t)(f->state | f->toggle));
 			if (!f->stuck_toggle) {
 				f->toggle ^= 0x80;
@@ -1018,7 +1053,8 @@ ZTEST(co_mgr, test_s9_19_start_all_with_missing_optional_starts_individually)
 	}
 	t.fakes[2].present = false;
 	start_master();
-	run_for(500 * MS);
+	/* The absent slave is tried once its boot-up wait is over. */
+	run_for((CONFIG_CANOPEN_MGR_BOOTUP_WAIT + 500) * MS);
 	zassert_equal(count_nmt(0x01, 0), 0);
 	zassert_equal(count_nmt(0x01, 2), 1);
 	zassert_equal(count_nmt(0x01, 3), 1);
@@ -1122,7 +1158,8 @@ ZTEST(co_mgr, test_s9_25_keep_alive_operational_slave_is_L_without_reset_or_chec
 	f->hb_ms = 100;
 	f->next_hb = 50 * MS;
 	start_master();
-	run_for(1000 * MS);
+	/* Slaves 3 and 4 are absent: tried after their boot-up wait. */
+	run_for((CONFIG_CANOPEN_MGR_BOOTUP_WAIT + 500) * MS);
 	zassert_equal(last_boot_status(2), CO_MGR_ST_L);
 	zassert_equal(last_boot_err(2)->step, CO_MGR_STEP_START);
 	zassert_equal(count_nmt(0x82, 2) + count_nmt(0x81, 2), 0, "never reset");
@@ -2031,8 +2068,12 @@ ZTEST(co_mgr, test_boot_table_keeps_last_result_during_a_retry)
 	fake_std(3)->present = false;
 	fake_std(4);
 	start_master();
-	run_for(500 * MS);
-	zassert_ok(co_mgr_get_boot(&t.master, 3, &bi));
+	/* Absent: no boot-up, its first attempt follows the boot-up wait. Run until it ended. */
+	do {
+		run_for(10 * MS);
+		zassert_ok(co_mgr_get_boot(&t.master, 3, &bi));
+	} while (bi.status == CO_MGR_ST_NONE &&
+		 t.now < (CONFIG_CANOPEN_MGR_BOOTUP_WAIT + 500) * MS);
 	zassert_false(bi.booting);
 	zassert_equal(bi.status, CO_MGR_ST_B);
 	zassert_equal(bi.attempts, 1);
@@ -2241,3 +2282,209 @@ ZTEST(co_mgr, test_1f25h_uses_only_clients_above_the_slave_slots)
 #endif
 }
 #endif /* CONFIG_CANOPEN_CFG */
+
+/* --- The master leaves Pre-operational during the startup (302-2 §3.1, §4.2) ------------------ */
+
+/* An NMT frame from another device on the bus, received by the master now. */
+static void bus_nmt(uint8_t cs, uint8_t id)
+{
+	struct can_frame f = {.id = 0x000, .dlc = 2, .data = {cs, id}};
+
+	co_line_rx(&t.line, &f, t.now);
+}
+
+/* The SDO abort frame the master sent to @p id, its index in the log or -1. */
+static int find_sdo_abort(uint8_t id, uint16_t index, uint32_t code)
+{
+	for (int i = 0; i < t.n_log; i++) {
+		const struct can_frame *f = &t.log[i].f;
+
+		if (f->id == 0x600U + id && f->dlc == 8 && f->data[0] == 0x80 &&
+		    sys_get_le16(&f->data[1]) == index && sys_get_le32(&f->data[4]) == code) {
+			return i;
+		}
+	}
+	return -1;
+}
+
+static int count_boot_ind(uint8_t id, uint8_t status)
+{
+	int n = 0;
+
+	for (int i = 0; i < t.n_boot_ind; i++) {
+		n += t.boot_id[i] == id && t.boot_status[i] == status ? 1 : 0;
+	}
+	return n;
+}
+
+/*
+ * The fuzzer's case: the master is stopped and started again (by another device) while the
+ * first SDO of an optional keep-alive slave's boot waits for its answer. The cut transfer is
+ * aborted on the bus, the attempt ends (B, reported), the startup ends, and the slave is
+ * booted again as soon as the master runs again.
+ */
+ZTEST(co_mgr, test_master_stopped_during_boot_ends_attempt_startup_and_reboots_slave_when_started)
+{
+	struct co_mgr_boot_info info;
+	struct fake *f;
+	int i;
+
+	cfg(0x1F80, 0, 0x01, 4);
+	cfg(0x1F89, 0, 500, 4);
+	cfg(0x1F81, 2, 0x75, 4); /* optional: slave, boot, keep-alive, SW check and update */
+	cfg(0x1F53, 2, 3000, 4);
+	cfg(0x1F54, 2, 4000, 4);
+	f = fake_std(2);
+	f->present = false; /* the first request is not answered before the stop */
+	start_master();
+	run_until(0);
+	i = first_sdo(2, true, 0x1000, 0);
+	zassert_true(i >= 0 && t.log[i].at < 1 * MS, "602#40 00 10 00 before 1 ms");
+	run_until(1 * MS);
+	bus_nmt(0x02, MASTER);
+	bus_nmt(0x01, MASTER);
+	f->present = true;
+	run_for(30000 * MS);
+
+	zassert_equal(t.n_startup_ind, 1, "the startup ends");
+	zassert_equal(t.startup_result, CO_MGR_STARTUP_DONE);
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_DONE);
+	i = find_sdo_abort(2, 0x1000, CO_SDO_AB_DATA_DEV_STATE);
+	zassert_true(i >= 0, "the cut upload is aborted on the bus");
+	zassert_equal(t.log[i].at, 1 * MS);
+	zassert_equal(f->n_aborts, 1);
+	/* The cut attempt is reported, then the new attempt boots the slave. */
+	zassert_equal(count_boot_ind(2, CO_MGR_ST_B), 1);
+	zassert_equal(t.boot_status[0], CO_MGR_ST_B);
+	zassert_equal(t.boot_err[0].step, CO_MGR_STEP_DEVTYPE);
+	zassert_equal(t.boot_err[0].index, 0x1000);
+	zassert_equal(t.boot_err[0].abort_code, CO_SDO_AB_DATA_DEV_STATE);
+	zassert_equal(last_boot_status(2), CO_MGR_ST_OK);
+	zassert_ok(co_mgr_get_boot(&t.master, 2, &info));
+	zassert_equal(info.status, CO_MGR_ST_OK);
+	zassert_false(info.booting);
+	zassert_equal(info.attempts, 2);
+	zassert_equal(count_sdo(2, true, 0x1000, 0), 2);
+	zassert_true(t.log[first_nmt(0x01, 2)].at < 1 * MS + 200 * MS, "booted after the start");
+	zassert_equal(count_nmt(0x01, 2), 1);
+	zassert_equal(master_state(), CO_NMT_OPERATIONAL);
+}
+
+/*
+ * 1F80h bit 6: a mandatory slave misses its first guarding answer while an optional slave's
+ * boot waits for an SDO answer. The master stops the network and itself; the optional slave's
+ * upload is aborted on the bus, its attempt ends (B), and the startup ends with the master left
+ * Stopped and nothing started. Started again, the master boots the optional slave.
+ */
+ZTEST(co_mgr, test_stop_all_on_mandatory_guarding_loss_aborts_boot_sdo_and_ends_startup)
+{
+	struct co_mgr_boot_info info;
+	struct fake *o;
+	int stop;
+	int ab;
+
+	cfg(0x1F80, 0, 0x41, 4);
+	cfg(0x1F81, 2, 0x0032010D, 4); /* mandatory, guard time 50 ms, retry factor 1 */
+	cfg(0x1F81, 3, 0x05, 4);       /* optional */
+	fake_std(2)->rtr_skip = 1;
+	o = fake_std(3);
+	o->mute_sdo = true;
+	start_master();
+	run_for(90 * MS);
+
+	stop = first_nmt(0x02, 0);
+	zassert_true(stop >= 0, "000#0200");
+	zassert_equal(master_state(), CO_NMT_STOPPED);
+	zassert_equal(t.n_startup_ind, 1, "the startup ends");
+	zassert_equal(t.startup_result, CO_MGR_STARTUP_DONE);
+	ab = find_sdo_abort(3, 0x1000, CO_SDO_AB_DATA_DEV_STATE);
+	zassert_true(ab > stop, "the optional slave's upload is aborted on the bus");
+	zassert_equal(t.log[ab].at, t.log[stop].at);
+	zassert_ok(co_mgr_get_boot(&t.master, 3, &info));
+	zassert_false(info.booting);
+	zassert_equal(info.status, CO_MGR_ST_B);
+	zassert_equal(info.attempts, 1);
+	zassert_equal(info.error.step, CO_MGR_STEP_DEVTYPE);
+	zassert_equal(info.error.abort_code, CO_SDO_AB_DATA_DEV_STATE);
+
+	/* Stopped: no SDO, no start, the error handler's stop stands. */
+	run_for(3000 * MS);
+	zassert_equal(count_nmt(0x02, 0), 1);
+	zassert_equal(count_sdo(3, true, 0x1000, 0), 1);
+	for (int i = stop; i < t.n_log; i++) {
+		zassert_false(t.log[i].f.id == 0x000 && t.log[i].f.data[0] == 0x01,
+			      "nothing started after the stop");
+	}
+	zassert_equal(master_state(), CO_NMT_STOPPED);
+	zassert_equal(t.n_startup_ind, 1);
+
+	/* Started again: the optional slave is booted and started. */
+	o->mute_sdo = false;
+	bus_nmt(0x01, MASTER);
+	run_for(500 * MS);
+	zassert_equal(master_state(), CO_NMT_OPERATIONAL);
+	zassert_equal(last_boot_status(3), CO_MGR_ST_OK);
+	zassert_equal(count_nmt(0x01, 3), 1);
+	zassert_ok(co_mgr_get_boot(&t.master, 3, &info));
+	zassert_equal(info.attempts, 2);
+}
+
+/* --- The boot waits for the slave's boot-up after the startup's reset (302-2 §3.1) ------------ */
+
+/*
+ * A slave that needs 5 ms to come back from Reset Communication ignores SDO requests before
+ * its boot-up. Its boot starts with the boot-up: milliseconds, not an SDO timeout, so a
+ * mandatory slave boots well within 1F89h.
+ */
+ZTEST(co_mgr, test_boot_waits_for_the_bootup_after_the_startup_reset_communication)
+{
+	struct fake *f;
+	int reset;
+	int up;
+	int start;
+
+	cfg(0x1F80, 0, 0x01, 4);
+	cfg(0x1F81, 2, 0x0D, 4); /* mandatory */
+	cfg(0x1F89, 0, 500, 4);
+	f = fake_std(2);
+	f->bootup_us = 5 * MS;
+	start_master();
+	run_for(600 * MS);
+
+	reset = first_nmt(0x82, 0);
+	up = first_sdo(2, true, 0x1000, 0);
+	start = first_nmt(0x01, 2);
+	zassert_true(reset >= 0 && up > reset && start > up);
+	zassert_true(t.log[up].at >= t.log[reset].at + 5 * MS, "first SDO after the boot-up");
+	zassert_equal(count_sdo(2, true, 0x1000, 0), 1, "no SDO timeout, no retry");
+	zassert_true(t.log[start].at - t.log[reset].at < 50 * MS, "OPERATIONAL after %llu us",
+		     t.log[start].at - t.log[reset].at);
+	zassert_equal(last_boot_status(2), CO_MGR_ST_OK);
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_DONE);
+}
+
+/* A slave that sends no boot-up after the reset is booted after the bounded wait. */
+ZTEST(co_mgr, test_boot_without_bootup_after_the_startup_reset_starts_after_bounded_wait)
+{
+	const uint64_t wait = (uint64_t)CONFIG_CANOPEN_MGR_BOOTUP_WAIT * MS;
+	struct fake *f;
+	int reset;
+	int up;
+
+	cfg(0x1F80, 0, 0x01, 4);
+	cfg(0x1F81, 2, 0x05, 4);
+	f = fake_std(2);
+	f->no_bootup = true;
+	start_master();
+	run_for(wait + 500 * MS);
+
+	reset = first_nmt(0x82, 0);
+	up = first_sdo(2, true, 0x1000, 0);
+	zassert_true(reset >= 0 && up > reset);
+	zassert_true(t.log[up].at - t.log[reset].at >= wait, "waited for a boot-up");
+	zassert_true(t.log[up].at - t.log[reset].at < wait + 10 * MS, "bounded");
+	zassert_equal(count_sdo(2, true, 0x1000, 0), 1);
+	zassert_equal(last_boot_status(2), CO_MGR_ST_OK);
+	zassert_equal(count_nmt(0x01, 2), 1);
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_DONE);
+}
