@@ -191,6 +191,8 @@ struct co_line_stats {
 	uint32_t tx_dropped;   /**< Frames dropped because the TX queue was full. */
 	uint32_t tx_errors;    /**< Sends refused by the driver with an error. */
 	uint16_t tx_queue_max; /**< Highest TX queue occupancy seen. */
+	/** Queued frames a node withdrew (co_line_tx_purge(), e.g. on entering Stopped). */
+	uint32_t tx_purged;
 	/** Receivers a frame did not reach: more matched than CONFIG_CANOPEN_LINE_RX_FANOUT. */
 	uint32_t rx_fanout_drops;
 };
@@ -228,6 +230,8 @@ struct co_line {
 	/* TX ring; frames wait here while the driver pushes back. */
 	struct k_mutex tx_lock;
 	struct can_frame txq[CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE];
+	/* The sending node's mutex of each queued frame (NULL: sent with co_line_send()). */
+	const struct k_mutex *txq_origin[CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE];
 	uint16_t tx_head;
 	uint16_t tx_count;
 	uint16_t tx_inflight;
@@ -474,6 +478,21 @@ int co_line_tx_space(struct co_line *line);
  */
 int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 		      const struct k_mutex *origin);
+
+/**
+ * @brief Withdraw frames a node queued on the line (waiting for back-pressure to clear).
+ *
+ * The node core calls it when a node enters Stopped: what the node queued before (an SDO
+ * answer, a PDO) must not go out in a state where only NMT and error control may speak.
+ *
+ * @param line The line.
+ * @param origin The node's mutex, as given to co_line_send_from().
+ * @param keep Frames to keep (NULL: none); called with the line's TX lock held, must not block.
+ * @param arg Passed to @p keep.
+ * @return Number of frames withdrawn (counted in co_line_stats.tx_purged).
+ */
+int co_line_tx_purge(struct co_line *line, const struct k_mutex *origin,
+		     bool (*keep)(const struct can_frame *frame, void *arg), void *arg);
 
 /**
  * @brief Attach a node to the line (co_node_init() does it).

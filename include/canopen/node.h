@@ -218,15 +218,35 @@ int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx);
  * @{
  */
 
+/** @cond INTERNAL_HIDDEN */
+int co_node_send_routed(struct co_node *node, co_route_t route, const struct can_frame *frame);
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_node_assert_locked(const struct co_node *node);
+#endif
+/** @endcond */
+
 /**
  * @brief Send a frame on every line of @p route the node is attached to.
+ *
+ * Inline for the common case of a node on one line (the PDO hot path).
  *
  * @retval 0 Sent or queued on every line of the route.
  * @retval -ENODEV The node has no line on that route.
  * @retval other As co_line_send(), the first error of the lines of the route (the frame is
  *         still sent on the others).
  */
-int co_node_send(struct co_node *node, co_route_t route, const struct can_frame *frame);
+static inline int co_node_send(struct co_node *node, co_route_t route,
+			       const struct can_frame *frame)
+{
+	if (node->lines[CO_LINE_REDUNDANT].line == NULL &&
+	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE)) != 0U) {
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+		co_node_assert_locked(node);
+#endif
+		return co_line_send_from(node->lines[CO_LINE_DEFAULT].line, frame, &node->lock);
+	}
+	return co_node_send_routed(node, route, frame);
+}
 
 /** @brief The route that answers a frame received by @p rx (the line it came on). */
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx);

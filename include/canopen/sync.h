@@ -54,6 +54,8 @@ struct co_sync {
 	uint8_t overflow;
 	uint8_t counter;
 	bool enabled;
+	/* 8240h (wrong SYNC length) is reported as present. */
+	bool length_error;
 	co_sync_ind_t ind;
 	void *ind_user_data;
 	co_sync_ind_t post_ind;

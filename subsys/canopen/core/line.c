@@ -643,12 +643,14 @@ static int tx_submit(struct co_line *line, const struct can_frame *frame)
 	return err;
 }
 
-static void txq_push(struct co_line *line, const struct can_frame *frame)
+static void txq_push(struct co_line *line, const struct can_frame *frame,
+		     const struct k_mutex *origin)
 {
 	uint16_t tail =
 		(uint16_t)((line->tx_head + line->tx_count) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
 
 	line->txq[tail] = *frame;
+	line->txq_origin[tail] = origin;
 	line->tx_count++;
 	line->stats.tx_queued++;
 	atomic_set_bit(&line->flags, CO_LINE_F_TX_WAITING);
@@ -657,7 +659,8 @@ static void txq_push(struct co_line *line, const struct can_frame *frame)
 	}
 }
 
-int co_line_send(struct co_line *line, const struct can_frame *frame)
+static int line_send(struct co_line *line, const struct can_frame *frame,
+		     const struct k_mutex *origin)
 {
 	int err = 0;
 	bool overflow = false;
@@ -669,7 +672,7 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 		if (err == 0) {
 			line->stats.tx_frames++;
 		} else if (err == -EAGAIN) {
-			txq_push(line, frame);
+			txq_push(line, frame, origin);
 			err = 0;
 		} else {
 			line->stats.tx_errors++;
@@ -677,7 +680,7 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 		}
 	} else if (line->tx_count < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE) {
 		/* Frames are waiting: queue behind them to keep the order. */
-		txq_push(line, frame);
+		txq_push(line, frame, origin);
 	} else {
 		line->stats.tx_dropped++;
 		overflow = true;
@@ -692,6 +695,43 @@ int co_line_send(struct co_line *line, const struct can_frame *frame)
 		co_line_report_from_send(line, CO_LINE_EV_TX_ERROR, err);
 	}
 	return err;
+}
+
+int co_line_send(struct co_line *line, const struct can_frame *frame)
+{
+	return line_send(line, frame, NULL);
+}
+
+int co_line_tx_purge(struct co_line *line, const struct k_mutex *origin,
+		     bool (*keep)(const struct can_frame *frame, void *arg), void *arg)
+{
+	uint16_t w = 0;
+	int purged = 0;
+
+	k_mutex_lock(&line->tx_lock, K_FOREVER);
+	/* Compact the ring in place, oldest first, so the frames kept stay in order. */
+	for (uint16_t r = 0; r < line->tx_count; r++) {
+		uint16_t from = (uint16_t)((line->tx_head + r) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+		uint16_t to = (uint16_t)((line->tx_head + w) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
+
+		if (line->txq_origin[from] == origin &&
+		    (keep == NULL || !keep(&line->txq[from], arg))) {
+			purged++;
+			continue;
+		}
+		if (to != from) {
+			line->txq[to] = line->txq[from];
+			line->txq_origin[to] = line->txq_origin[from];
+		}
+		w++;
+	}
+	line->tx_count = w;
+	line->stats.tx_purged += (uint32_t)purged;
+	if (line->tx_count == 0U) {
+		atomic_clear_bit(&line->flags, CO_LINE_F_TX_WAITING);
+	}
+	k_mutex_unlock(&line->tx_lock);
+	return purged;
 }
 
 int co_line_tx_space(struct co_line *line)
@@ -782,7 +822,7 @@ bool co_line_owner_held(struct co_line *line)
 int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 		      const struct k_mutex *origin)
 {
-	int err = co_line_send(line, frame);
+	int err = line_send(line, frame, origin);
 	uint8_t n_nodes = __atomic_load_n(&line->n_nodes, __ATOMIC_RELAXED);
 
 	if (err == 0 && n_nodes > 1U) {

@@ -68,28 +68,49 @@ void co_node_listener_remove(struct co_node *node, struct co_listener *l)
 	co_node_unlock(node);
 }
 
-int co_node_publish(struct co_node *node, const struct co_event *ev, const char **who)
+/* A veto round: the first refusal ends it and names who refused. */
+static __attribute__((noinline)) int veto_round(struct co_node *node, const struct co_event *ev,
+						const char **who)
 {
 	struct co_listener *l;
 	struct co_listener *next;
+
+	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&node->listeners, l, next, snode) {
+		if ((l->mask & CO_EV_BIT(CO_EV_NMT_VETO)) == 0U) {
+			continue;
+		}
+		int ret = l->cb(node, ev, l->user_data);
+
+		if (ret != 0) {
+			if (who != NULL) {
+				*who = l->name;
+			}
+			return ret;
+		}
+	}
+	return 0;
+}
+
+int co_node_publish(struct co_node *node, const struct co_event *ev, const char **who)
+{
 	uint32_t bit = CO_EV_BIT(ev->type);
+	sys_snode_t *sn;
+	sys_snode_t *next;
 
 	CO_ASSERT_LOCKED(&node->lock);
 	if ((node->listen_mask & bit) == 0U) {
 		return 0;
 	}
-	/* The safe walk lets a listener remove itself from its handler. */
-	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&node->listeners, l, next, snode) {
-		if ((l->mask & bit) == 0U) {
-			continue;
-		}
-		int ret = l->cb(node, ev, l->user_data);
+	if (ev->type == CO_EV_NMT_VETO) {
+		return veto_round(node, ev, who);
+	}
+	/* Next is taken before the call: a listener may remove itself from its handler. */
+	for (sn = sys_slist_peek_head(&node->listeners); sn != NULL; sn = next) {
+		struct co_listener *l = CONTAINER_OF(sn, struct co_listener, snode);
 
-		if (ev->type == CO_EV_NMT_VETO && ret != 0) {
-			if (who != NULL) {
-				*who = l->name;
-			}
-			return ret;
+		next = sys_slist_peek_next_no_check(sn);
+		if ((l->mask & bit) != 0U) {
+			(void)l->cb(node, ev, l->user_data);
 		}
 	}
 	return 0;
@@ -183,12 +204,29 @@ static const struct nmt_transition {
 	{.cs = CO_NMT_CS_RESET_COMMUNICATION, .reset = true, .to = CO_NMT_INITIALISING},
 };
 
+/* In Stopped a node sends NMT error control only (CiA 301 §7.3.2.2); NMT commands of a master. */
+static bool stopped_may_send(const struct can_frame *f, void *arg)
+{
+	const struct co_node *node = arg;
+
+	return f->id == CO_NMT_EC_COB_ID + node->node_id || f->id == CO_NMT_COB_ID;
+}
+
 static void nmt_enter(struct co_node *node, enum co_nmt_state to)
 {
 	enum co_nmt_state from = node->nmt.state;
 	struct co_event ev = {.type = CO_EV_NMT_STATE, .nmt = {.from = from, .to = to}};
 
 	node->nmt.state = to;
+	if (to == CO_NMT_STOPPED) {
+		/* Frames queued before (an SDO answer held up by back-pressure) stay unsent. */
+		for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
+			if (node->lines[i].line != NULL) {
+				(void)co_line_tx_purge(node->lines[i].line, &node->lock,
+						       stopped_may_send, node);
+			}
+		}
+	}
 	LOG_INF("%s: %s -> %s", node->name, co_nmt_state_str(from), co_nmt_state_str(to));
 	services_set_state(node, from, to);
 	(void)co_node_publish(node, &ev, NULL);
@@ -475,12 +513,13 @@ static inline co_route_t route_resolve(const struct co_node *node, co_route_t ro
 	return route;
 }
 
-int co_node_send(struct co_node *node, co_route_t route, const struct can_frame *frame)
+/* Sending on a route with a redundant line: every line of the route, the first error kept. */
+static __attribute__((noinline)) int send_routed(struct co_node *node, co_route_t route,
+						 const struct can_frame *frame)
 {
 	int ret = -ENODEV;
 	bool sent = false;
 
-	CO_ASSERT_LOCKED(&node->lock);
 	route = route_resolve(node, route);
 	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
 		struct co_line *line = node->lines[i].line;
@@ -497,6 +536,19 @@ int co_node_send(struct co_node *node, co_route_t route, const struct can_frame 
 	}
 	return ret;
 }
+
+int co_node_send_routed(struct co_node *node, co_route_t route, const struct can_frame *frame)
+{
+	CO_ASSERT_LOCKED(&node->lock);
+	return send_routed(node, route, frame);
+}
+
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_node_assert_locked(const struct co_node *node)
+{
+	CO_ASSERT_LOCKED(&node->lock);
+}
+#endif
 
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx)
 {

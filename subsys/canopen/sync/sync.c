@@ -123,12 +123,21 @@ static void sync_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	if (!s->enabled || (frame->flags & CAN_FRAME_RTR) != 0U) {
 		return;
 	}
+	/* 8240h is reported when it appears and when it goes, not per frame: a valid SYNC costs
+	 * no error event.
+	 */
 	if (frame->dlc != want) {
-		co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U,
-			      CO_ERROR_F_ACTIVE);
+		if (!s->length_error) {
+			s->length_error = true;
+			co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U,
+				      CO_ERROR_F_ACTIVE);
+		}
 		return;
 	}
-	co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U, 0U);
+	if (s->length_error) {
+		s->length_error = false;
+		co_node_error(node, CO_EMCY_SYNC_LENGTH, CO_EMCY_REG_COMMUNICATION, 0U, 0U);
+	}
 	indicate(node, want != 0U ? frame->data[0] : 0U, now_us);
 }
 
@@ -274,6 +283,8 @@ static void sync_reset_comm(struct co_node *node)
 		s->cob_id = (uint32_t)co_od_uint(&node->od, IDX_COB_ID, 0, CO_SYNC_COB_ID);
 	}
 	s->period_us = (uint32_t)co_od_uint(&node->od, IDX_PERIOD, 0, 0U);
+	/* Reset Communication drops the stack's own errors (EMCY does the same). */
+	s->length_error = false;
 	s->window_us = (uint32_t)co_od_uint(&node->od, IDX_WINDOW, 0, 0U);
 	s->overflow = (uint8_t)co_od_uint(&node->od, IDX_OVERFLOW, 0, 0U);
 	if (s->overflow == 1U || s->overflow > 240U) {

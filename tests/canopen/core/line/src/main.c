@@ -88,6 +88,11 @@ static void rx_fill(struct co_rx *rx, uint32_t id, uint32_t mask, bool ext, int 
 	rx->user_data = (void *)(intptr_t)tag;
 }
 
+static bool keep_error_control(const struct can_frame *f, void *arg)
+{
+	return (f->id & 0x780U) == 0x700U;
+}
+
 static struct can_frame std_frame(uint32_t id, uint8_t dlc)
 {
 	struct can_frame f = {.id = id, .dlc = dlc};
@@ -444,6 +449,33 @@ ZTEST(co_line, test_line_knows_whether_a_node_lock_is_held)
 	zassert_is_null(co_line_current(), "the test thread is no line thread");
 	co_line_detach(&fx.line, &m);
 	co_line_detach(&fx.line, &m); /* safe twice */
+}
+
+ZTEST(co_line, test_purge_withdraws_one_nodes_queued_frames_in_order)
+{
+	struct k_mutex a, b;
+	struct co_line_stats st;
+	/* Odd IDs from node a, even ones from b; the test line queues 4 frames. */
+	static const uint32_t ids[] = {0x705, 0x585, 0x586, 0x187};
+
+	k_mutex_init(&a);
+	k_mutex_init(&b);
+	fx.sink_result = -EAGAIN; /* back-pressure: everything waits in the queue */
+	for (size_t i = 0; i < ARRAY_SIZE(ids); i++) {
+		struct can_frame f = std_frame(ids[i], 1);
+
+		zassert_ok(co_line_send_from(&fx.line, &f, (ids[i] & 1U) ? &a : &b));
+	}
+	/* Node a withdraws what it queued except its error control. */
+	zassert_equal(co_line_tx_purge(&fx.line, &a, keep_error_control, NULL), 2);
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.tx_purged, 2);
+
+	fx.sink_result = 0;
+	co_line_process(&fx.line, 10);
+	zassert_equal(fx.sent_len, 2);
+	zassert_equal(fx.sent[0].id, 0x705, "a's heartbeat stays");
+	zassert_equal(fx.sent[1].id, 0x586, "b's frame stays, behind it");
 }
 
 ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)

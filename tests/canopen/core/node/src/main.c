@@ -332,6 +332,53 @@ ZTEST(co_node, test_line_events_name_their_line)
 	zassert_equal(t.a.line_idx[1], CO_LINE_REDUNDANT);
 }
 
+/* --- Stopped ---------------------------------------------------------------------------- */
+
+static int blocked;
+
+static int slow_sink(struct co_line *line, const struct can_frame *frame, void *user_data)
+{
+	if (blocked) {
+		return -EAGAIN;
+	}
+	zassert_true(t.n_sent2 < (int)ARRAY_SIZE(t.sent2));
+	t.sent2[t.n_sent2++] = *frame;
+	return 0;
+}
+
+ZTEST(co_node, test_stopped_node_sends_nothing_it_queued_before)
+{
+	static struct co_line slow;
+	static struct co_node n;
+	static struct node_test_od_ram ram;
+	static const uint8_t sdo_read[8] = {0x40, 0x00, 0x10, 0x00};
+	struct can_frame f = {.id = 0x600 + 9, .dlc = 8};
+	struct can_frame stop = {.id = 0x000, .dlc = 2, .data = {CO_NMT_CS_STOP, 9}};
+
+	memcpy(f.data, sdo_read, 8);
+	blocked = 0;
+	co_line_init_sim(&slow, "slow", slow_sink, NULL);
+	zassert_ok(co_node_init(&n, "n9", &slow, &node_test_od_def, &ram, 9));
+	zassert_ok(co_node_start(&n));
+	blocked = 1;
+	/* An SDO request: its answer waits in the line's queue (back-pressure). */
+	zassert_equal(co_line_rx(&slow, &f, 1000), 1);
+	zassert_ok(co_nmt_req(&n, CO_NMT_CS_START));
+	zassert_equal(co_line_rx(&slow, &stop, 2000), 1);
+	zassert_equal(co_nmt_get_state(&n), CO_NMT_STOPPED);
+
+	t.n_sent2 = 0;
+	blocked = 0;
+	co_line_process(&slow, 3000);
+	co_line_process(&slow, 1003000);
+	for (int i = 0; i < t.n_sent2; i++) {
+		zassert_equal(t.sent2[i].id, 0x709, "only error control in Stopped, not %03x",
+			      t.sent2[i].id);
+	}
+	zassert_true(t.n_sent2 >= 1, "the heartbeat still goes out");
+	co_line_detach(&slow, &n.lines[CO_LINE_DEFAULT].member);
+}
+
 /* --- Unconfigured node-ID --------------------------------------------------------------- */
 
 ZTEST(co_node, test_unconfigured_node_stays_silent_until_it_gets_an_id)
