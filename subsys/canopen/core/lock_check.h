@@ -14,9 +14,9 @@
 
 #include <stdbool.h>
 
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
 #include <zephyr/kernel.h>
 
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
 /* Log who broke the rule where, then k_panic(). */
 void co_lock_violation(const struct k_mutex *lock, const char *file, int line);
 

@@ -500,8 +500,11 @@ static void hooks_drop_from(struct co_od *od, uint32_t first)
 		}
 		od->hooks[w] = od->hooks[r];
 		od->hook_seq[w] = od->hook_seq[r];
-		od->hook_span = MAX(od->hook_span,
-				    (uint16_t)(od->hooks[w].index_last - od->hooks[w].index_first));
+		uint16_t span = od->hooks[w].index_last - od->hooks[w].index_first;
+
+		if (span > od->hook_span) {
+			od->hook_span = span;
+		}
 		w++;
 	}
 	od->n_hooks = w;
