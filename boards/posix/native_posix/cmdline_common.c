@@ -6,7 +6,9 @@
 /* Parsing and help of option tables (see cmdline_common.h). Host code. */
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +22,21 @@
 #define HELP_DESCR  "Print this help and exit"
 #define HELP_COLUMN 32  /* where descriptions start */
 #define LINE_WIDTH  100 /* wrap the help here */
+
+/*
+ * The table being parsed, for the usage printed with a value error (also from the
+ * call_when_found callbacks and from checks made right after the parse, before the boot).
+ */
+static struct args_struct_t *usage_table;
+
+static void print_usage(void)
+{
+	if (usage_table != NULL) {
+		(void)fputs("Usage: ", stdout);
+		cmd_print_switches_help(usage_table);
+	}
+	(void)fflush(stdout);
+}
 
 static const char *skip_dashes(const char *arg)
 {
@@ -48,8 +65,12 @@ int cmd_is_option(const char *arg, const char *option, int with_value)
 	}
 	if (arg[offset] != '=' && arg[offset] != ':') {
 		if (arg[offset] == '\0') {
-			posix_print_error_and_exit("Option '%s' needs a value: --%s=<value>\n", arg,
-						   option);
+			print_usage();
+			posix_print_error_and_exit(
+				"Error: option '%s' needs a value: --%s=<value>. "
+				"Use --help for the description of every "
+				"option.\n",
+				arg, option);
 		}
 		return 0;
 	}
@@ -65,12 +86,138 @@ int cmd_is_help_option(const char *arg)
 			       strcmp(name, "?") == 0);
 }
 
+static bool is_digit(char c)
+{
+	return c >= '0' && c <= '9';
+}
+
+int cmd_parse_uint(const char *str, uint64_t min, uint64_t max, uint64_t *out)
+{
+	unsigned long long v;
+	char *end = NULL;
+
+	/* strtoull() would skip spaces and take a sign ("-1" is ULLONG_MAX): not here. */
+	if (!is_digit(str[0])) {
+		return -EINVAL;
+	}
+	errno = 0;
+	v = strtoull(str, &end, 0);
+	if (*end != '\0') {
+		return -EINVAL;
+	}
+	if (errno == ERANGE || v < min || v > max) {
+		return -ERANGE;
+	}
+	*out = v;
+
+	return 0;
+}
+
+int cmd_parse_int(const char *str, int64_t min, int64_t max, int64_t *out)
+{
+	long long v;
+	char *end = NULL;
+
+	if (!is_digit(str[str[0] == '-' ? 1 : 0])) {
+		return -EINVAL;
+	}
+	errno = 0;
+	v = strtoll(str, &end, 0);
+	if (*end != '\0') {
+		return -EINVAL;
+	}
+	if (errno == ERANGE || v < min || v > max) {
+		return -ERANGE;
+	}
+	*out = v;
+
+	return 0;
+}
+
+int cmd_parse_double(const char *str, double min, double max, double *out)
+{
+	const char *digits = str + (str[0] == '-' ? 1 : 0);
+	char *end = NULL;
+	double v;
+
+	/* A digit first: no space, no '+', no "nan", "inf" or "infinity". */
+	if (!is_digit(digits[0]) && !(digits[0] == '.' && is_digit(digits[1]))) {
+		return -EINVAL;
+	}
+	errno = 0;
+	v = strtod(str, &end);
+	if (*end != '\0' || !isfinite(v)) {
+		return (*end == '\0') ? -ERANGE : -EINVAL;
+	}
+	if (errno == ERANGE || !(v >= min && v <= max)) {
+		return -ERANGE;
+	}
+	*out = v;
+
+	return 0;
+}
+
+void cmd_option_error(const char *option, const char *str, const char *format, ...)
+{
+	char reason[160];
+	va_list ap;
+
+	va_start(ap, format);
+	(void)vsnprintf(reason, sizeof(reason), format, ap);
+	va_end(ap);
+	print_usage();
+	posix_print_error_and_exit("Error: --%s='%s': %s. Use --help for the description of "
+				   "every option.\n",
+				   option, str, reason);
+}
+
+uint64_t cmd_read_uint_option(const char *option, const char *str, uint64_t min, uint64_t max)
+{
+	uint64_t v = 0;
+	int rc = cmd_parse_uint(str, min, max, &v);
+
+	if (rc == -EINVAL) {
+		cmd_option_error(option, str,
+				 "not an unsigned integer (decimal, 0x hex or 0 octal; no sign)");
+	} else if (rc != 0) {
+		cmd_option_error(option, str, "out of range (%llu..%llu)", (unsigned long long)min,
+				 (unsigned long long)max);
+	}
+
+	return v;
+}
+
+int64_t cmd_read_int_option(const char *option, const char *str, int64_t min, int64_t max)
+{
+	int64_t v = 0;
+	int rc = cmd_parse_int(str, min, max, &v);
+
+	if (rc == -EINVAL) {
+		cmd_option_error(option, str, "not an integer (decimal, 0x hex or 0 octal)");
+	} else if (rc != 0) {
+		cmd_option_error(option, str, "out of range (%lld..%lld)", (long long)min,
+				 (long long)max);
+	}
+
+	return v;
+}
+
+double cmd_read_double_option(const char *option, const char *str, double min, double max)
+{
+	double v = 0.0;
+	int rc = cmd_parse_double(str, min, max, &v);
+
+	if (rc == -EINVAL) {
+		cmd_option_error(option, str, "not a number");
+	} else if (rc != 0) {
+		cmd_option_error(option, str, "out of range (%g..%g)", min, max);
+	}
+
+	return v;
+}
+
 void cmd_read_option_value(const char *str, void *dest, const char type, const char *option)
 {
-	char *end = NULL;
-	bool error = false;
-
-	errno = 0;
 	switch (type) {
 	case 'b':
 		if (strcasecmp(str, "true") == 0 || strcmp(str, "1") == 0) {
@@ -78,51 +225,35 @@ void cmd_read_option_value(const char *str, void *dest, const char type, const c
 		} else if (strcasecmp(str, "false") == 0 || strcmp(str, "0") == 0) {
 			*(bool *)dest = false;
 		} else {
-			error = true;
+			cmd_option_error(option, str, "not a bool (true, false, 1 or 0)");
 		}
-		end = (char *)str + strlen(str);
 		break;
 	case 's':
 		*(char **)dest = (char *)str;
-		end = (char *)str + strlen(str);
 		break;
-	case 'u': {
-		unsigned long long v = strtoull(str, &end, 0);
-
-		error = (v > UINT32_MAX) || (str[0] == '-');
-		*(uint32_t *)dest = (uint32_t)v;
+	case 'u':
+		*(uint32_t *)dest = (uint32_t)cmd_read_uint_option(option, str, 0, UINT32_MAX);
 		break;
-	}
 	case 'U':
-		error = (str[0] == '-');
-		*(uint64_t *)dest = strtoull(str, &end, 0);
+		*(uint64_t *)dest = cmd_read_uint_option(option, str, 0, UINT64_MAX);
 		break;
-	case 'i': {
-		long long v = strtoll(str, &end, 0);
-
-		error = (v < INT32_MIN) || (v > INT32_MAX);
-		*(int32_t *)dest = (int32_t)v;
+	case 'i':
+		*(int32_t *)dest = (int32_t)cmd_read_int_option(option, str, INT32_MIN, INT32_MAX);
 		break;
-	}
 	case 'I':
-		*(int64_t *)dest = strtoll(str, &end, 0);
+		*(int64_t *)dest = cmd_read_int_option(option, str, INT64_MIN, INT64_MAX);
 		break;
 	case 'd':
-		*(double *)dest = strtod(str, &end);
+		*(double *)dest = cmd_read_double_option(option, str, -DBL_MAX, DBL_MAX);
 		break;
 	default:
 		posix_print_error_and_exit("Option %s: unknown type '%c'\n", option, type);
-	}
-
-	if (error || errno != 0 || end == str || *end != '\0') {
-		posix_print_error_and_exit("Error reading the value of --%s: '%s'. Use --help for "
-					   "the usage\n",
-					   option, str);
 	}
 }
 
 void cmd_args_set_defaults(struct args_struct_t args_struct[])
 {
+	usage_table = args_struct;
 	for (int i = 0; args_struct[i].option != NULL; i++) {
 		void *dest = args_struct[i].dest;
 
@@ -178,6 +309,7 @@ static void handle_matched_arg(char *argv, int offset, struct args_struct_t *arg
 
 bool cmd_parse_one_arg(char *argv, struct args_struct_t args_struct[])
 {
+	usage_table = args_struct;
 	if (cmd_is_help_option(argv)) {
 		cmd_print_long_help(args_struct);
 		posix_exit(0);

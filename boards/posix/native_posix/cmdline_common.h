@@ -17,6 +17,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -61,8 +62,36 @@ struct args_struct_t {
 int cmd_is_option(const char *arg, const char *option, int with_value);
 /* Whether arg is -h, --h, -help, --help, -? or --? (any case). */
 int cmd_is_help_option(const char *arg);
-/* Parse str as type into dest; on a malformed value print an error and exit(1). */
+/*
+ * Parse str as type into dest; on a malformed value print the usage and an error naming the
+ * option, and exit(1) (see cmd_read_uint_option() for what a number may look like).
+ */
 void cmd_read_option_value(const char *str, void *dest, const char type, const char *option);
+
+/*
+ * Strict values (a SafeLine extension: Zephyr's parser takes whatever strtoul() makes of it).
+ * The whole of str is the number: decimal, 0x hex or 0 octal, no space, no '+', a '-' only
+ * for a signed number, nothing after it, no wrap-around; a double is finite (no NaN, no inf).
+ * These return 0, -EINVAL (not a number) or -ERANGE (outside [min, max]).
+ */
+int cmd_parse_uint(const char *str, uint64_t min, uint64_t max, uint64_t *out);
+int cmd_parse_int(const char *str, int64_t min, int64_t max, int64_t *out);
+int cmd_parse_double(const char *str, double min, double max, double *out);
+
+/*
+ * The same, for the value of --option (e.g. from a call_when_found callback that checks a
+ * range): a value that does not fit ends the process as a malformed value does.
+ */
+uint64_t cmd_read_uint_option(const char *option, const char *str, uint64_t min, uint64_t max);
+int64_t cmd_read_int_option(const char *option, const char *str, int64_t min, int64_t max);
+double cmd_read_double_option(const char *option, const char *str, double min, double max);
+
+/*
+ * Refuse the value str of --option: print the usage (stdout), then
+ * "Error: --<option>=<str>: <reason>" (stderr), and exit(1) before the firmware boots.
+ */
+void cmd_option_error(const char *option, const char *str, const char *format, ...)
+	__attribute__((__noreturn__, __format__(__printf__, 3, 4)));
 /* Give every dest of the table its "not set" default (false, NULL, max values, NaN). */
 void cmd_args_set_defaults(struct args_struct_t args_struct[]);
 /* Parse one argument against the table; false if no option matched. */

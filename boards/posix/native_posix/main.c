@@ -20,6 +20,7 @@
 #include <signal.h>
 #include <stdarg.h>
 #include <stdatomic.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,18 +34,33 @@
 int __real_main(void);
 void z_cstart(int (*app_main)(void));
 
+/* The longest --stop-at, in seconds (about 31 years). */
+#define STOP_AT_MAX 1e9
+
 static double stop_at;
 static uint32_t seed;
+/* UINT32_MAX is the table's "not given" value but also a seed like any other. */
+static bool seed_given;
 static sem_t wake_sem;
 static volatile sig_atomic_t caught_signal;
+
+static void stop_at_found(char *argv, int offset)
+{
+	stop_at = cmd_read_double_option("stop-at", &argv[offset], 0.0, STOP_AT_MAX);
+}
+
+static void seed_found(char *argv, int offset)
+{
+	seed_given = true;
+}
 
 static void add_board_options(void)
 {
 	static struct args_struct_t board_options[] = {
-		{false, false, false, "stop-at", "time", 'd', &stop_at, NULL,
+		{false, false, false, "stop-at", "time", 'd', &stop_at, stop_at_found,
 		 "End the process with exit code 0 after <time> seconds (host time, from the "
-		 "start)"},
-		{false, false, false, "seed", "r_seed", 'u', &seed, NULL,
+		 "start; 0 to 1e9, fractions allowed)"},
+		{false, false, false, "seed", "r_seed", 'u', &seed, seed_found,
 		 "Seed of the pseudo-random generator sys_rand32_get(), e.g. 97229 or 0x17BCD "
 		 "(default 0x5678)"},
 		ARG_TABLE_ENDMARKER,
@@ -56,7 +72,7 @@ NATIVE_TASK(add_board_options, PRE_BOOT_1, 0);
 
 uint32_t native_get_seed(void)
 {
-	return (seed == UINT32_MAX) ? 0x5678U : seed;
+	return seed_given ? seed : 0x5678U;
 }
 
 static void vprint(FILE *stream, const char *format, va_list ap)
@@ -158,9 +174,6 @@ int __wrap_main(int argc, char *argv[])
 
 	run_native_tasks(_NATIVE_PRE_BOOT_1_LEVEL);
 	native_handle_cmd_line(argc, argv);
-	if (!isnan(stop_at) && !(stop_at >= 0.0 && stop_at < 1e9)) {
-		posix_print_error_and_exit("--stop-at: %g is not a time in seconds\n", stop_at);
-	}
 	run_native_tasks(_NATIVE_PRE_BOOT_2_LEVEL);
 	catch_signals();
 	run_native_tasks(_NATIVE_PRE_BOOT_3_LEVEL);

@@ -106,16 +106,24 @@ static char sc_ifname_override[SC_NUM_CTRL][SC_IFNAMSIZ];
 static void sc_can_if_found(char *argv, int offset)
 {
 	const char *value = argv + offset;
-	char *end = NULL;
-	long index = strtol(value, &end, 10);
+	const char *colon = strchr(value, ':');
+	char index_str[4];
+	size_t index_len = (colon != NULL) ? (size_t)(colon - value) : 0U;
+	uint64_t index;
 
-	if (end == value || *end != ':' || index < 0 || index >= SC_NUM_CTRL || end[1] == '\0' ||
-	    strlen(end + 1) >= SC_IFNAMSIZ) {
-		posix_print_error_and_exit("--can-if=%s: expected <controller 0..%d>:<ifname> "
-					   "(at most %d characters)\n",
-					   value, SC_NUM_CTRL - 1, SC_IFNAMSIZ - 1);
+	if (colon == NULL || index_len == 0U || index_len >= sizeof(index_str) ||
+	    colon[1] == '\0' || strlen(colon + 1) >= SC_IFNAMSIZ) {
+		cmd_option_error("can-if", value,
+				 "expected <controller 0..%d>:<ifname> (at most %d characters)",
+				 SC_NUM_CTRL - 1, SC_IFNAMSIZ - 1);
 	}
-	strcpy(sc_ifname_override[index], end + 1);
+	memcpy(index_str, value, index_len);
+	index_str[index_len] = '\0';
+	if (cmd_parse_uint(index_str, 0U, SC_NUM_CTRL - 1U, &index) != 0) {
+		cmd_option_error("can-if", value, "the controller is not a number in 0..%d",
+				 SC_NUM_CTRL - 1);
+	}
+	strcpy(sc_ifname_override[index], colon + 1);
 }
 
 static void sc_add_options(void)
@@ -180,6 +188,53 @@ static void sc_resolve_ifname(int index, char out[SC_IFNAMSIZ])
 	}
 	out[0] = '\0';
 }
+
+/* Why socketcan_host_open() failed with @p rc, for a message ending in the errno text. */
+static const char *sc_open_error(int rc)
+{
+	switch (rc) {
+	case -EAFNOSUPPORT:
+		return "the kernel has no AF_CAN, SocketCAN not available on this host (run in "
+		       "scripts/vcan-vm)";
+	case -ENODEV:
+		return "no such interface";
+	default:
+		return "socket error";
+	}
+}
+
+/*
+ * An interface named with --can-if must be usable: probe each one once the command line is
+ * parsed, so that a missing interface (or a host without AF_CAN) ends the process with the
+ * reason before the boot instead of leaving the line on the virtual bus. Interfaces from
+ * CONFIG_CAN_SOCKETCAN_IFNAMES alone are only reported (sc_init()).
+ */
+static void sc_check_can_if(void)
+{
+	for (int i = 0; i < SC_NUM_CTRL; i++) {
+		char ifname[SC_IFNAMSIZ];
+		int fd;
+
+		if (sc_ifname_override[i][0] == '\0') {
+			continue;
+		}
+		sc_resolve_ifname(i, ifname);
+		if (ifname[0] == '\0') {
+			posix_print_error_and_exit("Error: --can-if=%d:%s names no interface\n", i,
+						   sc_ifname_override[i]);
+		}
+		fd = socketcan_host_open(ifname);
+		if (fd < 0) {
+			posix_print_error_and_exit(
+				"Error: --can-if=%d:%s: cannot open CAN interface %s: %s "
+				"(%s)\n",
+				i, sc_ifname_override[i], ifname, sc_open_error(fd), strerror(-fd));
+		}
+		socketcan_host_close(fd);
+	}
+}
+
+NATIVE_TASK(sc_check_can_if, PRE_BOOT_2, 10);
 
 static inline struct sc_data *sc_data(const struct device *dev)
 {
@@ -787,10 +842,7 @@ static int sc_init(const struct device *dev)
 		int rc = d->fd;
 
 		LOG_ERR("%s: cannot open CAN interface %s: %s (%d)", dev->name, d->ifname,
-			rc == -EAFNOSUPPORT ? "the kernel has no AF_CAN (use scripts/vcan-vm)"
-			: rc == -ENODEV     ? "no such interface"
-					    : "socket error",
-			rc);
+			sc_open_error(rc), rc);
 		d->fd = -1;
 		return rc;
 	}

@@ -14,8 +14,13 @@
 
 LOG_MODULE_REGISTER(sample, LOG_LEVEL_INF);
 
-/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
-static uint32_t node_id_arg;
+/* 0: --node-id not given. Checked while the command line is parsed, before the boot. */
+static uint8_t node_id_arg;
+
+static void node_id_found(char *argv, int offset)
+{
+	node_id_arg = (uint8_t)cmd_read_uint_option("node-id", &argv[offset], 1U, 127U);
+}
 
 static void add_options(void)
 {
@@ -24,7 +29,7 @@ static void add_options(void)
 			.option = "node-id",
 			.name = "1..127",
 			.type = 'u',
-			.dest = &node_id_arg,
+			.call_when_found = node_id_found,
 			.descript = "CANopen node-ID of this device",
 		},
 		ARG_TABLE_ENDMARKER,
@@ -36,14 +41,7 @@ NATIVE_TASK(add_options, PRE_BOOT_1, 20);
 
 int sample_node_id(uint8_t dflt)
 {
-	if (node_id_arg == UINT32_MAX) {
-		return dflt;
-	}
-	if (node_id_arg < 1U || node_id_arg > 127U) {
-		LOG_ERR("--node-id must be 1..127 (got %u)", node_id_arg);
-		return -1;
-	}
-	return (int)node_id_arg;
+	return (node_id_arg == 0U) ? dflt : node_id_arg;
 }
 
 const struct device *sample_line_device(unsigned int n)

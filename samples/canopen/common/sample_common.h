@@ -19,12 +19,16 @@
 #include <canopen/line.h>
 
 /*
- * The node-ID given with --node-id, or @p dflt when the option was not given. Negative when
- * the value is outside 1..127 (an error is logged).
+ * The node-ID given with --node-id, or @p dflt when the option was not given. The command line
+ * refuses a value outside 1..127 before the boot (usage, error, exit code 1).
  */
 int sample_node_id(uint8_t dflt);
 
-/* CAN controller @p n: can_socketcan<n> when it has an interface, else can_virtual<n>. */
+/*
+ * CAN controller @p n: can_socketcan<n> when it has an interface, else can_virtual<n>. An
+ * interface named with --can-if that cannot be opened never gets here: the SocketCAN driver
+ * ends the process with the reason before the boot.
+ */
 const struct device *sample_line_device(unsigned int n);
 
 /* Print @p line's counters when the process ends (tests read them). */

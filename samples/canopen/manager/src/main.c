@@ -49,10 +49,28 @@ LOG_MODULE_REGISTER(manager, LOG_LEVEL_INF);
 #define FIRST_SLAVE 2U
 #define MAX_SLAVES  4U
 
-/* The board sets option variables to UINT32_MAX ("not given") before parsing. */
-static uint32_t slaves_arg;
-static uint32_t cycle_arg;
-static uint32_t cut_arg;
+/*
+ * The options, with their defaults. Each value is checked while the command line is parsed,
+ * so that a bad one ends the process (usage, error, exit code 1) before the boot.
+ */
+static unsigned int slaves_arg = MAX_SLAVES;
+static unsigned int cycle_arg = 4U;
+static unsigned int cut_arg = 3U;
+
+static void slaves_found(char *argv, int offset)
+{
+	slaves_arg = (unsigned int)cmd_read_uint_option("slaves", &argv[offset], 0U, MAX_SLAVES);
+}
+
+static void cycle_found(char *argv, int offset)
+{
+	cycle_arg = (unsigned int)cmd_read_uint_option("cycle", &argv[offset], 0U, 127U);
+}
+
+static void cut_found(char *argv, int offset)
+{
+	cut_arg = (unsigned int)cmd_read_uint_option("cut", &argv[offset], 0U, 127U);
+}
 
 static void add_options(void)
 {
@@ -61,7 +79,7 @@ static void add_options(void)
 			.option = "slaves",
 			.name = "0..4",
 			.type = 'u',
-			.dest = &slaves_arg,
+			.call_when_found = slaves_found,
 			.descript = "hello_node slaves run in this process (nodes 2.., lines 1..; "
 				    "default 4, 0 = the manager alone)",
 		},
@@ -69,7 +87,7 @@ static void add_options(void)
 			.option = "cycle",
 			.name = "node",
 			.type = 'u',
-			.dest = &cycle_arg,
+			.call_when_found = cycle_found,
 			.descript = "power-cycle this in-process slave 1 s after the startup "
 				    "(default 4, 0 = none)",
 		},
@@ -77,7 +95,7 @@ static void add_options(void)
 			.option = "cut",
 			.name = "node",
 			.type = 'u',
-			.dest = &cut_arg,
+			.call_when_found = cut_found,
 			.descript = "cut this in-process slave off the virtual bus 2 s after the "
 				    "startup, for 1 s (default 3, 0 = none)",
 		},
@@ -87,6 +105,21 @@ static void add_options(void)
 	native_add_command_line_opts(opts);
 }
 NATIVE_TASK(add_options, PRE_BOOT_1, 21);
+
+/* Once the whole command line is parsed, still before the boot. */
+static void check_options(void)
+{
+	int id = sample_node_id(MANAGER_ID);
+	char value[8];
+
+	if (id >= (int)FIRST_SLAVE && id < (int)(FIRST_SLAVE + MAX_SLAVES)) {
+		(void)snprintf(value, sizeof(value), "%d", id);
+		cmd_option_error("node-id", value,
+				 "%u..%u are the slaves of the network description", FIRST_SLAVE,
+				 FIRST_SLAVE + MAX_SLAVES - 1U);
+	}
+}
+NATIVE_TASK(check_options, PRE_BOOT_2, 21);
 
 struct slave {
 	struct co_line line;
@@ -490,9 +523,9 @@ static int start_manager(uint8_t id)
 
 int main(void)
 {
-	unsigned int n_slaves = slaves_arg == UINT32_MAX ? MAX_SLAVES : slaves_arg;
-	unsigned int cycle = cycle_arg == UINT32_MAX ? 4U : cycle_arg;
-	unsigned int cut = cut_arg == UINT32_MAX ? 3U : cut_arg;
+	unsigned int n_slaves = slaves_arg;
+	unsigned int cycle = cycle_arg;
+	unsigned int cut = cut_arg;
 	unsigned int next = DEMO_COUNT; /* next demo action; DEMO_COUNT: none pending */
 	int64_t done_ms = 0;
 	int id = sample_node_id(MANAGER_ID);
@@ -501,17 +534,6 @@ int main(void)
 	struct event ev;
 	int err;
 
-	if (id < 0) {
-		return 1;
-	}
-	if (id >= (int)FIRST_SLAVE && id < (int)(FIRST_SLAVE + MAX_SLAVES)) {
-		LOG_ERR("--node-id %d is a slave of the network description (2..5)", id);
-		return 1;
-	}
-	if (n_slaves > MAX_SLAVES) {
-		LOG_ERR("--slaves must be 0..%u (got %u)", MAX_SLAVES, n_slaves);
-		return 1;
-	}
 	if (cycle != 0U && (cycle < FIRST_SLAVE || cycle >= FIRST_SLAVE + n_slaves)) {
 		cycle = 0U; /* not a slave of this process */
 	}

@@ -113,3 +113,101 @@ def test_fatal_errors(run):
     result = run("--fatal=assert", "--node-id=12345")
     assert result.returncode == 0, "a true assertion does nothing"
     assert "no fatal error" in result.stdout
+
+
+# --- Strict values: every bad value is refused before the firmware boots -----------------------
+
+BAD_VALUES = [
+    # unsigned 32-bit ('u'): no sign, no space, no wrap, nothing after the number
+    ("node-id", " -18446744073709551615"),
+    ("node-id", "-18446744073709551615"),
+    ("node-id", "18446744073709551617"),
+    ("node-id", "4294967296"),
+    ("node-id", "+5"),
+    ("node-id", " 5"),
+    ("node-id", "5 "),
+    ("node-id", "5x"),
+    ("node-id", "0x"),
+    ("node-id", "08"),
+    ("node-id", ""),
+    ("node-id", "nan"),
+    ("seed", " -4294967295"),
+    ("seed", " -18446744073709551615"),
+    ("seed", "-0"),
+    ("seed", "1e3"),
+    # signed 32-bit ('i')
+    ("exit", "2147483648"),
+    ("exit", "-2147483649"),
+    ("exit", "--1"),
+    ("exit", "+1"),
+    ("exit", " 1"),
+    ("exit", "9223372036854775808"),
+    # --stop-at: a finite, non-negative number of seconds
+    ("stop-at", "nan"),
+    ("stop-at", "NAN"),
+    ("stop-at", "-nan"),
+    ("stop-at", "inf"),
+    ("stop-at", "infinity"),
+    ("stop-at", "-1"),
+    ("stop-at", "-0.5"),
+    ("stop-at", "1e999"),
+    ("stop-at", "1s"),
+    ("stop-at", " 1"),
+    ("stop-at", "+1"),
+    ("stop-at", ""),
+]
+
+
+def assert_refused(result, option, value):
+    what = f"--{option}={value!r}"
+    assert result.returncode == 1, f"{what}: exit code {result.returncode}"
+    assert "Booting" not in result.stdout, f"{what}: the firmware booted"
+    assert result.stdout.startswith("Usage:"), f"{what}: no usage on stdout"
+    assert f"--{option}" in result.stderr, f"{what}: the error does not name the option"
+    assert "Error" in result.stderr, what
+
+
+def test_bad_values_are_refused_before_boot_with_usage(run):
+    for option, value in BAD_VALUES:
+        # A value the parser lets through must not hang the test (--stop-at=nan did).
+        try:
+            result = run(f"--{option}={value}", "--exit=0", timeout=10)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"--{option}={value!r} was accepted and never stopped")
+        assert_refused(result, option, value)
+
+
+def test_bad_stop_at_does_not_run_forever(run):
+    for value in ("nan", "inf", "-1", "later"):
+        try:
+            result = run(f"--stop-at={value}", timeout=10)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"--stop-at={value} never stopped")
+        assert_refused(result, "stop-at", value)
+
+
+def test_full_range_values_are_accepted(run):
+    # UINT32_MAX is the table parser's "not given" value: given, it is a value like any other.
+    result = run("--node-id=4294967295", "--exit=0")
+    assert result.returncode == 0
+    assert "node_id=4294967295 " in result.stdout
+
+    result = run("--seed=4294967295", "--exit=0")
+    assert result.returncode == 0
+    assert "seed=4294967295" in result.stdout, "--seed=UINT32_MAX is not the default seed"
+
+    for value, seed in (("0", 0), ("0xFFFFFFFF", 4294967295), ("017", 15)):
+        result = run(f"--seed={value}", "--exit=0")
+        assert result.returncode == 0, value
+        assert f"seed={seed}" in result.stdout, value
+
+    for value, code in (("-3", 253), ("0x7", 7), ("-0", 0)):
+        result = run(f"--exit={value}")
+        assert result.returncode == code, value
+
+
+def test_good_stop_at_values(run):
+    for value, shown in (("0.2", "0.200"), ("2e-1", "0.200"), ("0", "0.000")):
+        result = run(f"--stop-at={value}", timeout=30)
+        assert result.returncode == 0, value
+        assert f"Stopped at {shown}s" in result.stdout, value
