@@ -29,6 +29,7 @@
 #include <zephyr/sys/byteorder.h>
 #include <zephyr/sys/util.h>
 
+#include <canopen/cob_id.h>
 #include <canopen/node.h>
 #include <canopen/sdo.h>
 
@@ -929,14 +930,6 @@ static void srv_configure(struct co_sdo_srv *srv)
 	}
 }
 
-/* CAN-IDs no SDO may use (CiA 301 §7.3.5): those of other predefined services. */
-static bool can_id_restricted(uint32_t id)
-{
-	return id <= 0x07fU || (id >= 0x101U && id <= 0x180U) || (id >= 0x581U && id <= 0x5ffU) ||
-	       (id >= 0x601U && id <= 0x67fU) || (id >= 0x6e0U && id <= 0x6ffU) ||
-	       (id >= 0x701U && id <= 0x7ffU);
-}
-
 static uint32_t cobid_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_sdo_srv *srv0 = user_data;
@@ -966,7 +959,7 @@ static uint32_t cobid_validate(struct co_od *od, struct co_od_req *req, void *us
 		return CO_SDO_AB_INVALID_VALUE;
 	}
 	if (cobid_valid(val) && (val & CO_SDO_COBID_FRAME) == 0U &&
-	    can_id_restricted(val & SFF_MASK)) {
+	    co_cob_id_restricted(val & SFF_MASK)) {
 		bool is_default =
 			num == 0U && srv0->node != NULL &&
 			val == (sub == 1U ? CO_SDO_SRV_DEFAULT_RX : CO_SDO_SRV_DEFAULT_TX) +
