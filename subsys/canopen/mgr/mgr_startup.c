@@ -262,14 +262,31 @@ static void startup_boot(struct co_mgr *m)
 	startup_check(m);
 }
 
+/*
+ * The startup process (CiA 302-2, NMT startup) as a const table: what the start timer does in
+ * each phase. The phases without a step wait for something else: the NMT queue to send the
+ * last reset (co_mgr_startup_resets_sent()), the boots to end (startup_check()).
+ */
+static const struct startup_phase {
+	const char *name;
+	void (*step)(struct co_mgr *m);
+} startup_phases[] = {
+	[PH_NONE] = {.name = "idle"},
+	[PH_BEGIN] = {.name = "begin: reset the slaves", .step = startup_begin},
+	[PH_RESETTING] = {.name = "resetting"},
+	[PH_BOOT] = {.name = "boot every slave", .step = startup_boot},
+	[PH_BOOTING] = {.name = "booting"},
+};
+
 /* Startup steps run from the line thread: after our own boot-up, and after the resets. */
 void co_mgr_start_timer_handler(struct co_timer *timer, uint64_t now_us)
 {
 	struct co_mgr *m = timer->user_data;
+	const struct startup_phase *p = &startup_phases[m->phase];
 
-	if (m->phase == PH_BEGIN) {
-		startup_begin(m);
-	} else if (m->phase == PH_BOOT) {
-		startup_boot(m);
+	ARG_UNUSED(now_us);
+	if (p->step != NULL) {
+		LOG_DBG("%s: startup: %s", m->node->name, p->name);
+		p->step(m);
 	}
 }
