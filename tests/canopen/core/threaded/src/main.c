@@ -273,3 +273,70 @@ ZTEST(co_threaded, test_frames_sent_while_the_line_is_stopped_go_out_at_start)
 	zassert_equal(after.tx_dropped, before.tx_dropped);
 	zassert_true(after.tx_frames > before.tx_frames);
 }
+
+/* --- A node on both lines ------------------------------------------------------------------ */
+
+static struct test_node dual;
+static atomic_t seen_on[N_LINES];
+
+static void count_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	atomic_inc(rx->user_data);
+	k_sem_give(&events);
+}
+
+static bool seen(int a, int b)
+{
+	return atomic_get(&seen_on[0]) == a && atomic_get(&seen_on[1]) == b;
+}
+
+static bool seen_1_0(void)
+{
+	return seen(1, 0);
+}
+
+static bool seen_1_1(void)
+{
+	return seen(1, 1);
+}
+
+static bool seen_2_2(void)
+{
+	return seen(2, 2);
+}
+
+ZTEST(co_threaded, test_node_on_two_virtual_lines_sends_on_each_route)
+{
+	struct can_frame f = {.id = 0x555, .dlc = 1, .data = {0x5A}};
+	struct co_rx rx[N_LINES];
+
+	/* Observers: a receiver of a node of each line (frames reach them by local delivery). */
+	for (int l = 0; l < N_LINES; l++) {
+		co_rx_init(&rx[l], 0x555, count_rx, &nodes[l][0].node.lock, &seen_on[l]);
+		zassert_ok(co_rx_register(&lines[l], &rx[l]));
+	}
+	zassert_ok(co_node_init(&dual.node, "dual", &lines[0], &nmt_test_od_def, &dual.ram, 10));
+	zassert_ok(co_node_attach_line(&dual.node, CO_LINE_REDUNDANT, &lines[1]));
+	zassert_ok(co_node_start(&dual.node));
+
+	co_node_lock(&dual.node);
+	zassert_ok(co_node_send(&dual.node, CO_ROUTE_DEFAULT, &f));
+	co_node_unlock(&dual.node);
+	zassert_true(wait_until(seen_1_0), "default route: line A only");
+
+	co_node_lock(&dual.node);
+	zassert_ok(co_node_send(&dual.node, CO_ROUTE_REDUNDANT, &f));
+	co_node_unlock(&dual.node);
+	zassert_true(wait_until(seen_1_1), "redundant route: line B");
+
+	co_node_lock(&dual.node);
+	zassert_ok(co_node_send(&dual.node, CO_ROUTE_BOTH, &f));
+	co_node_unlock(&dual.node);
+	zassert_true(wait_until(seen_2_2), "both routes: one more on each line");
+
+	k_msleep(50);
+	zassert_true(seen(2, 2), "nothing more");
+	for (int l = 0; l < N_LINES; l++) {
+		co_rx_unregister(&rx[l]);
+	}
+}
