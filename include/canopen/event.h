@@ -57,6 +57,12 @@ enum co_event_type {
 	CO_EV_NMT_VETO,
 	/** A Reset Node or Reset Communication is about to run (@ref co_event.reset). */
 	CO_EV_NMT_RESET,
+	/**
+	 * The node is about to leave "nmt.from" for "nmt.to" (@ref co_event.nmt), decided (no
+	 * veto pending): the last moment to send in the old state, e.g. to abort an SDO transfer
+	 * before Stopped forbids SDO. Raised for every change, the resets' Initialising included.
+	 */
+	CO_EV_NMT_LEAVE,
 	/** The heartbeat consumer saw something of a remote node (@ref co_event.hb). */
 	CO_EV_HB,
 	/** Life guarding of this node was lost or resumed (@ref co_event.life). */
@@ -96,7 +102,7 @@ enum co_event_type {
 struct co_event {
 	enum co_event_type type;
 	union {
-		/** CO_EV_NMT_STATE, CO_EV_NMT_VETO. */
+		/** CO_EV_NMT_STATE, CO_EV_NMT_VETO, CO_EV_NMT_LEAVE. */
 		struct {
 			enum co_nmt_state from;
 			enum co_nmt_state to;

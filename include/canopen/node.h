@@ -104,8 +104,6 @@ struct co_node {
 	/* The services, from the list of canopen/services.h (set by co_node_init()). */
 	const struct co_service *const *services;
 	uint8_t n_services;
-	/* Services initialised so far (co_node_init() undoes them on failure). */
-	uint8_t n_services_up;
 	struct co_nmt nmt;
 	struct co_rx nmt_rx;
 	sys_slist_t listeners;
@@ -124,7 +122,8 @@ struct co_node {
  * Binds the node to its line, dictionary and node-ID and initialises every service of
  * canopen/services.h in order (each registers its dictionary hooks, receivers and
  * listeners). On failure everything already done is undone: the node is left unregistered
- * from the line and may be initialised again.
+ * from the line and may be initialised again. A node that is initialised already (attached to
+ * a line) must not be initialised again.
  *
  * @param node Node to initialise (statically allocated).
  * @param name Name for logs; must outlive the node.
@@ -137,8 +136,6 @@ struct co_node {
  * @retval -EINVAL A NULL argument or a node-ID outside 1..127 and not CO_NODE_ID_UNCONFIGURED.
  * @retval -ENOSPC A receiver, hook or listener did not fit in its table (line receive slots,
  *         CONFIG_CANOPEN_OD_HOOKS, ...).
- * @retval -EALREADY A receiver or listener of this node was registered already (the node
- *         struct was not zeroed, or is initialised twice without success in between).
  * @retval other negative errno As returned by a service's initialisation (see its header).
  */
 int co_node_init(struct co_node *node, const char *name, struct co_line *line,
@@ -147,8 +144,11 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
 /**
  * @brief Attach the node to a second line (redundancy).
  *
- * Call after co_node_init() and before co_node_start(). Services register the receivers of
- * that line at the next Reset Communication.
+ * Call after co_node_init() and before co_node_start(). The node then hears the line's events
+ * (CO_EV_LINE with its index), may send on it (CO_ROUTE_REDUNDANT, CO_ROUTE_BOTH) and register
+ * receivers on it (co_node_rx_register()). The services of today still receive on the default
+ * line only (NMT, error control and the rest); which service listens where on a redundant
+ * line is the redundancy service's decision.
  *
  * @retval 0 Attached.
  * @retval -EINVAL A NULL argument, or @p idx is not CO_LINE_REDUNDANT.

@@ -760,17 +760,13 @@ void co_line_attach(struct co_line *line, struct co_line_member *m, const struct
 /* Drop every receiver and timer of one owner (a node leaving the line). */
 static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 {
-	for (unsigned int id = 0; id < CO_LINE_SFF_IDS; id++) {
-		uint8_t slot = line->sff[id];
-		struct co_rx *rx = slot != 0U ? line->slots[slot - 1U] : NULL;
-
-		while (rx != NULL) {
-			struct co_rx *next = rx->next;
-
+	/* The used slots hold every exact 11-bit receiver; rx_unlink() frees emptied ones. */
+	for (unsigned int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
+		for (struct co_rx *rx = line->slots[i], *next; rx != NULL; rx = next) {
+			next = rx->next;
 			if (rx->lock == lock) {
 				rx_unlink(line, rx);
 			}
-			rx = next;
 		}
 	}
 	for (struct co_rx *rx = line->others, *next; rx != NULL; rx = next) {

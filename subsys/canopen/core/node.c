@@ -157,18 +157,6 @@ static void services_set_state(struct co_node *node, enum co_nmt_state from, enu
 	}
 }
 
-/* Undo the initialisation of the first node->n_services_up services, last first. */
-static void services_deinit(struct co_node *node)
-{
-	while (node->n_services_up > 0U) {
-		const struct co_service *svc = node->services[--node->n_services_up];
-
-		if (svc->deinit != NULL) {
-			svc->deinit(node);
-		}
-	}
-}
-
 /* --- NMT slave state machine -------------------------------------------------------------- */
 
 const char *co_nmt_state_str(enum co_nmt_state state)
@@ -215,8 +203,10 @@ static bool stopped_may_send(const struct can_frame *f, void *arg)
 static void nmt_enter(struct co_node *node, enum co_nmt_state to)
 {
 	enum co_nmt_state from = node->nmt.state;
-	struct co_event ev = {.type = CO_EV_NMT_STATE, .nmt = {.from = from, .to = to}};
+	struct co_event ev = {.type = CO_EV_NMT_LEAVE, .nmt = {.from = from, .to = to}};
 
+	(void)co_node_publish(node, &ev, NULL);
+	ev.type = CO_EV_NMT_STATE;
 	node->nmt.state = to;
 	if (to == CO_NMT_STOPPED) {
 		/* Frames queued before (an SDO answer held up by back-pressure) stay unsent. */
@@ -513,13 +503,16 @@ static inline co_route_t route_resolve(const struct co_node *node, co_route_t ro
 	return route;
 }
 
-/* Sending on a route with a redundant line: every line of the route, the first error kept. */
-static __attribute__((noinline)) int send_routed(struct co_node *node, co_route_t route,
-						 const struct can_frame *frame)
+/*
+ * Sending on a route other than the one line (co_node_send() in node.h takes that path
+ * inline): every line of the route, the first error kept.
+ */
+int co_node_send_routed(struct co_node *node, co_route_t route, const struct can_frame *frame)
 {
 	int ret = -ENODEV;
 	bool sent = false;
 
+	CO_ASSERT_LOCKED(&node->lock);
 	route = route_resolve(node, route);
 	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
 		struct co_line *line = node->lines[i].line;
@@ -535,12 +528,6 @@ static __attribute__((noinline)) int send_routed(struct co_node *node, co_route_
 		sent = true;
 	}
 	return ret;
-}
-
-int co_node_send_routed(struct co_node *node, co_route_t route, const struct can_frame *frame)
-{
-	CO_ASSERT_LOCKED(&node->lock);
-	return send_routed(node, route, frame);
 }
 
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
@@ -632,10 +619,9 @@ int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
 		co_rx_init(&node->nmt_rx, CO_NMT_COB_ID, nmt_rx, &node->lock, node);
 		err = co_node_rx_register(node, CO_LINE_DEFAULT, &node->nmt_rx);
 	}
-	while (err == 0 && node->n_services_up < node->n_services) {
-		const struct co_service *svc = node->services[node->n_services_up];
+	for (size_t i = 0; err == 0 && i < n_services; i++) {
+		const struct co_service *svc = services[i];
 
-		node->n_services_up++;
 		if (svc->init != NULL) {
 			err = svc->init(node);
 			if (err != 0) {
@@ -644,8 +630,6 @@ int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
 		}
 	}
 	if (err != 0) {
-		services_deinit(node);
-		co_rx_unregister(&node->nmt_rx);
 		/* Leaving the line drops every receiver and timer of the node's mutex. */
 		line_leave(node, CO_LINE_DEFAULT);
 		/* And a fresh dictionary drops every hook the services registered. */

@@ -23,10 +23,11 @@
 /*
  * A service. Every operation is optional (NULL) and runs with the node's mutex held.
  *
- * init:       once, from co_node_init(): register hooks, receivers, listeners. A negative
- *             errno fails the node's initialisation, after the node has called deinit of
- *             the services initialised before (in reverse order), and of this one.
- * deinit:     undo init (unregister what init registered); safe on a partial init.
+ * init:       once, from co_node_init(): register hooks, receivers, listeners, timers. A
+ *             negative errno fails the node's initialisation; the core then undoes what
+ *             every service registered (it leaves the line with every receiver and timer of
+ *             the node's mutex, and starts the dictionary afresh), so a service whose init
+ *             uses only those needs no undo of its own.
  * reset_comm: NMT Reset Communication (and the first boot): configure from the dictionary.
  * set_state:  the node entered @p to from @p from.
  */
@@ -34,7 +35,6 @@ struct co_service {
 	const char *name;
 	uint32_t flags;
 	int (*init)(struct co_node *node);
-	void (*deinit)(struct co_node *node);
 	void (*reset_comm)(struct co_node *node);
 	void (*set_state)(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to);
 };

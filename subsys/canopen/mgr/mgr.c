@@ -87,6 +87,11 @@ static void slaves_reset(struct co_mgr *m)
 	}
 }
 
+static bool sdo_runs_in(enum co_nmt_state st)
+{
+	return st == CO_NMT_PRE_OPERATIONAL || st == CO_NMT_OPERATIONAL;
+}
+
 /*
  * The master is about to leave the states in which SDO runs (a Stop, or a reset, of its own
  * or from another device): abort the boot transfers on the bus while it may still send them
@@ -95,13 +100,9 @@ static void slaves_reset(struct co_mgr *m)
 static int mgr_event(struct co_node *node, const struct co_event *ev, void *user_data)
 {
 	struct co_mgr *m = user_data;
-	enum co_nmt_state st = co_node_nmt_state(node);
 
-	if (st != CO_NMT_PRE_OPERATIONAL && st != CO_NMT_OPERATIONAL) {
-		return 0;
-	}
-	if (ev->type == CO_EV_NMT_VETO &&
-	    (ev->nmt.to == CO_NMT_PRE_OPERATIONAL || ev->nmt.to == CO_NMT_OPERATIONAL)) {
+	ARG_UNUSED(node);
+	if (!sdo_runs_in(ev->nmt.from) || sdo_runs_in(ev->nmt.to)) {
 		return 0;
 	}
 	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
@@ -135,8 +136,7 @@ static int mgr_init(struct co_node *node)
 	if (co_node_rx_register(m->node, CO_LINE_DEFAULT, &m->ec_rx) != 0) {
 		return -ENOSPC;
 	}
-	co_listener_init(&m->listener, "mgr",
-			 CO_EV_BIT(CO_EV_NMT_VETO) | CO_EV_BIT(CO_EV_NMT_RESET), mgr_event, m);
+	co_listener_init(&m->listener, "mgr", CO_EV_BIT(CO_EV_NMT_LEAVE), mgr_event, m);
 	if (co_node_listener_add(node, &m->listener) != 0) {
 		return -ENOSPC;
 	}

@@ -62,10 +62,8 @@ LOG_MODULE_DECLARE(co_node, CONFIG_CANOPEN_LOG_LEVEL);
 #define MAP_DAM_MPDO CO_MPDO_DAM
 #define MAP_MAX      64U
 
-#define EMCY_PDO_LENGTH     CO_EMCY_PDO_LENGTH
-#define EMCY_PDO_LENGTH_EXC CO_EMCY_PDO_LENGTH_EXC
-#define EMCY_RPDO_TIMEOUT   CO_EMCY_RPDO_TIMEOUT
-#define EMCY_DAM_MISSING    0x8230U
+/* 8230h: DAM MPDO not processed, destination object not available (CiA 301 table 21). */
+#define EMCY_DAM_MISSING 0x8230U
 
 #define ERR_SHORT   BIT(0)
 #define ERR_LONG    BIT(1)
@@ -95,10 +93,14 @@ static bool is_sync_type(uint8_t type)
 	return type <= CO_PDO_TT_SYNC_MAX;
 }
 
-/* Without the SYNC service nothing would ever trigger a synchronous PDO: refuse the type. */
+/*
+ * Without the SYNC service nothing would ever trigger a synchronous PDO (0..240, and the
+ * synchronous RTR type 252): refuse the type.
+ */
 static bool sync_type_served(uint8_t type)
 {
-	return IS_ENABLED(CONFIG_CANOPEN_SYNC) || !is_sync_type(type);
+	return IS_ENABLED(CONFIG_CANOPEN_SYNC) ||
+	       !(is_sync_type(type) || type == CO_PDO_TT_RTR_SYNC);
 }
 
 static bool is_event_type(uint8_t type)
@@ -219,10 +221,10 @@ static void rpdo_error(struct co_rpdo *r, uint8_t bit, bool on)
 	}
 	r->errors ^= bit;
 	struct co_node *node = r->node;
-	uint16_t code = bit == ERR_SHORT  ? EMCY_PDO_LENGTH
-			: bit == ERR_LONG ? EMCY_PDO_LENGTH_EXC
+	uint16_t code = bit == ERR_SHORT  ? CO_EMCY_PDO_LENGTH
+			: bit == ERR_LONG ? CO_EMCY_PDO_LENGTH_EXC
 			: bit == ERR_DAM  ? EMCY_DAM_MISSING
-					  : EMCY_RPDO_TIMEOUT;
+					  : CO_EMCY_RPDO_TIMEOUT;
 
 	if (on) {
 		co_node_error(node, code, CO_EMCY_REG_COMMUNICATION, 0U, CO_ERROR_F_ACTIVE);
@@ -762,8 +764,7 @@ static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_RTR_SYNC) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
-		if (!sync_type_served((uint8_t)v) ||
-		    (v == CO_PDO_TT_RTR_SYNC && !IS_ENABLED(CONFIG_CANOPEN_SYNC))) {
+		if (!sync_type_served((uint8_t)v)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		if (is_rtr_type((uint8_t)v) && (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) ||
@@ -1069,8 +1070,7 @@ static void pdo_reset_comm(struct co_node *node)
 		}
 		t->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
 		t->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
-		if (!sync_type_served(t->type) ||
-		    (t->type == CO_PDO_TT_RTR_SYNC && !IS_ENABLED(CONFIG_CANOPEN_SYNC))) {
+		if (!sync_type_served(t->type)) {
 			LOG_ERR("%s: TPDO %u is synchronous, the node has no SYNC; it stays off",
 				node->name, i + 1U);
 			t->cob_id |= CO_PDO_COB_INVALID;

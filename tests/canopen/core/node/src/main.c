@@ -62,7 +62,8 @@ static int listener(struct co_node *node, const struct co_event *ev, void *user_
 
 	if (s->n < (int)ARRAY_SIZE(s->type)) {
 		s->type[s->n] = ev->type;
-		s->to[s->n] = (ev->type == CO_EV_NMT_STATE || ev->type == CO_EV_NMT_VETO)
+		s->to[s->n] = (ev->type == CO_EV_NMT_STATE || ev->type == CO_EV_NMT_VETO ||
+			       ev->type == CO_EV_NMT_LEAVE)
 				      ? ev->nmt.to
 				      : CO_NMT_INITIALISING;
 		s->line_idx[s->n] = ev->type == CO_EV_LINE ? ev->line.idx : 0xFFU;
@@ -217,6 +218,34 @@ ZTEST(co_node, test_vetoes_compose_and_name_who_refused)
 	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_OPERATIONAL);
 	zassert_ok(co_nmt_req(&t.node, CO_NMT_CS_RESET_COMMUNICATION));
 	zassert_is_null(co_nmt_get_refusal(&t.node, NULL));
+}
+
+static enum co_nmt_state state_at_leave;
+
+static int leave_listener(struct co_node *node, const struct co_event *ev, void *user_data)
+{
+	state_at_leave = node->nmt.state;
+	return listener(node, ev, user_data);
+}
+
+ZTEST(co_node, test_leave_is_raised_before_the_change_and_only_when_decided)
+{
+	co_listener_init(&t.a.l, "leave", CO_EV_BIT(CO_EV_NMT_LEAVE), leave_listener, &t.a);
+	zassert_ok(co_node_listener_add(&t.node, &t.a.l));
+	add(&t.b, "refuses-stop", CO_EV_BIT(CO_EV_NMT_VETO));
+	zassert_ok(co_node_start(&t.node));
+	zassert_equal(t.a.n, 1, "Initialising -> Pre-operational");
+
+	t.b.veto = -EACCES;
+	zassert_equal(co_nmt_req(&t.node, CO_NMT_CS_STOP), -EPERM);
+	zassert_equal(t.a.n, 1, "a refused change raises no leave");
+
+	t.b.veto = 0;
+	zassert_ok(co_nmt_req(&t.node, CO_NMT_CS_STOP));
+	zassert_equal(t.a.n, 2);
+	zassert_equal(t.a.type[1], CO_EV_NMT_LEAVE);
+	zassert_equal(t.a.to[1], CO_NMT_STOPPED);
+	zassert_equal(state_at_leave, CO_NMT_PRE_OPERATIONAL, "raised before the change");
 }
 
 ZTEST(co_node, test_resets_are_not_offered_for_a_veto)
@@ -566,6 +595,19 @@ static void *no_sync_setup(void)
 		ztest_test_skip();
 	}
 	return NULL;
+}
+
+ZTEST(co_pdo_without_sync, test_synchronous_pdo_from_the_dictionary_stays_off)
+{
+	/* RPDO 2 of the dictionary is synchronous (1401h:02 = 1) on 300h + node-ID. */
+	struct can_frame rpdo2 = {.id = 0x300 + NODE_ID, .dlc = 8};
+	struct can_frame rpdo1 = {.id = 0x200 + NODE_ID, .dlc = 8};
+
+	before(NULL);
+	zassert_ok(co_node_start(&t.node));
+	zassert_ok(co_nmt_req(&t.node, CO_NMT_CS_START));
+	zassert_equal(co_line_rx(&sim.line, &rpdo2, sim.now), 0, "no receiver: the PDO is off");
+	zassert_equal(co_line_rx(&sim.line, &rpdo1, sim.now), 1, "the event-driven one runs");
 }
 
 ZTEST(co_pdo_without_sync, test_synchronous_types_are_refused_06090030)
