@@ -16,7 +16,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import Optional
 
-from . import dtypes
+from . import dtypes, srdo
 
 ACCESS = ("ro", "wo", "rw", "rwr", "rww", "const")
 OBJCODES = {0x2: "DOMAIN", 0x5: "DEFTYPE", 0x6: "DEFSTRUCT", 0x7: "VAR", 0x8: "ARRAY",
@@ -235,6 +235,10 @@ class Sub:
     high: Optional[Value]
     size: int  # wire capacity in bytes
     line: int
+    # where the effective value was written (0: no value), and the section of the sub-index
+    # (the object's section for a VAR or a CompactSubObj array)
+    value_line: int = 0
+    sec: Optional[Section] = field(default=None, repr=False, compare=False)
     # filled by the generator
     rom: bool = False
     store: bool = False
@@ -370,6 +374,7 @@ class Builder:
             bitrate = self.num(dc, "Baudrate", 0)
             node_name = dc.get("NodeName", "")
         self.check_cobids(objects, node_id)
+        srdo.check(objects, objs, node_id, self.err)
         return Model(rd.path, objects, header, node_id, bitrate, node_name, self.is_dcf)
 
     def check_lists(self, objs):
@@ -459,7 +464,7 @@ class Builder:
                 return None
             u8 = dtypes.BY_CODE[0x0005]
             subs.append(Sub(0, "Number of entries", u8, "ro", False, Value(n), None, None, 1,
-                            sec.line_of("CompactSubObj")))
+                            sec.line_of("CompactSubObj"), sec.line_of("CompactSubObj"), sec))
             names = aux.get((idx, "name"))
             values = aux.get((idx, "value"))
             proto = self.build_sub(idx, 1, sec, name, allow_param=False)
@@ -473,6 +478,7 @@ class Builder:
                     try:
                         s.default = parse_value(s.dtype, values.get(str(i)),
                                                 f"[{values.name}] {i}")
+                        s.value_line = values.line_of(str(i))
                         self.check_limits(s, values.line_of(str(i)))
                     except ValueError as e:
                         self.err(values.line_of(str(i)), str(e))
@@ -551,6 +557,7 @@ class Builder:
             self.err(sec.line_of("PDOMapping"), f"{where}: PDOMapping must be 0 or 1")
         pdo_map = pm in ("1", "0x1")
         default = low = high = None
+        value_line = 0
         bad = False
         for key in ("DefaultValue", "LowLimit", "HighLimit") + (
                 ("ParameterValue",) if allow_param else ()):
@@ -571,10 +578,9 @@ class Builder:
                 self.err(sec.line_of(key), str(e))
                 bad = True
                 continue
-            if key == "DefaultValue":
-                default = val
-            elif key == "ParameterValue":
-                default = val  # a DCF's configured value wins
+            if key in ("DefaultValue", "ParameterValue"):
+                default = val  # ParameterValue comes last: a DCF's configured value wins
+                value_line = sec.line_of(key)
             elif key == "LowLimit":
                 low = val
             else:
@@ -599,7 +605,7 @@ class Builder:
         elif size_key is not None:
             self.err(sec.line_of("SafeLineSize"), f"{where}: SafeLineSize on fixed-size type "
                                                   f"{t.name}")
-        s = Sub(sub, name, t, acc, pdo_map, default, low, high, size, sec.line)
+        s = Sub(sub, name, t, acc, pdo_map, default, low, high, size, sec.line, value_line, sec)
         if bad:
             return s
         needs_default = (acc in ("ro", "const") and t.cls != "DOMAIN") or (

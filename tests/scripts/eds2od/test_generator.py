@@ -9,7 +9,7 @@ import subprocess
 
 import pytest
 
-from eds2od_testlib import BASE, DATA, GOLDEN, run_eds2od
+from eds2od_testlib import BASE, DATA, GOLDEN, run_eds2od, srdo_comm, srdo_map
 
 GOLDEN_CASES = [("alltypes.eds", "alltypes"), ("device.dcf", "device"), ("minimal.eds", "minimal")]
 
@@ -160,9 +160,26 @@ def _with_client_sdo(eds, tmp_path):
     return path
 
 
+def _with_srdos(eds, tmp_path):
+    """io401.eds plus two disabled SRDOs, 1301h/1381h and 1302h/1382h (io401 has none)."""
+    text = open(eds, encoding="utf-8").read()
+    m = re.search(r"\[OptionalObjects\]\nSupportedObjects=(\d+)\n", text)
+    n = int(m.group(1))
+    idxs = [0x1301, 0x1302, 0x1381, 0x1382]
+    text = text.replace(m.group(0), f"[OptionalObjects]\nSupportedObjects={n + len(idxs)}\n" +
+                        "".join(f"{n + 1 + i}=0x{x:04X}\n" for i, x in enumerate(idxs)))
+    srdos = "".join(srdo_comm(k, 0, 0, 0, 0, 0, 0) + srdo_map(k, [0, 0], count=0)
+                    for k in (1, 2))
+    text = text.replace("\n[1400]\n", "\n" + srdos + "[1400]\n", 1)
+    path = tmp_path / "io_srdo.eds"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
 @pytest.mark.parametrize("key,sym,guard", [
     ("RPDO", "CONFIG_CANOPEN_RPDOS", "CONFIG_CANOPEN_PDO"),
     ("TPDO", "CONFIG_CANOPEN_TPDOS", "CONFIG_CANOPEN_PDO"),
+    ("SRDO", "CONFIG_CANOPEN_SRDOS", "CONFIG_CANOPEN_SRDO"),
     ("EM_HIST", "CONFIG_CANOPEN_EMCY_HISTORY", "CONFIG_CANOPEN_EMCY"),
     ("SDO_CLI", "CONFIG_CANOPEN_SDO_CLIENTS", "CONFIG_CANOPEN_SDO_CLIENT"),
 ])
@@ -173,6 +190,8 @@ def test_counts_checked_against_kconfig_only_with_the_service(tmp_path, key, sym
     eds = os.path.join(DATA, "io401.eds")
     if key == "SDO_CLI":
         eds = _with_client_sdo(eds, tmp_path)
+    if key == "SRDO":
+        eds = _with_srdos(eds, tmp_path)
     r = run_eds2od(eds, out, "io")
     assert r.returncode == 0, r.stderr
     n = _count((out / "io_od.h").read_text(), "io", key)
