@@ -25,6 +25,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 #include <zephyr/sys/byteorder.h>
+#include <zephyr/sys/crc.h>
 #include <zephyr/sys/util.h>
 
 #include <canopen/node.h>
@@ -350,7 +351,7 @@ static uint32_t blk_dn_ack(struct co_sdo_cli *cli, const uint8_t *d, uint64_t no
 		r[0] = CO_SDO_B0(CO_SDO_CCS_BLK_DN,
 				 CO_SDO_BLK_N_PUT(CO_SDO_SEG_SIZE - last_len) | CO_SDO_BLK_SUB_END);
 		if (cli->crc_on) {
-			sys_put_le16(co_sdo_crc16(0U, cli->dn_data, cli->len), &r[1]);
+			sys_put_le16(crc16_itu_t(0U, cli->dn_data, cli->len), &r[1]);
 		}
 		cli->offset = cli->len;
 		cli->state = ST_BLK_DN_END;
@@ -507,7 +508,7 @@ static uint32_t blk_up_segment(struct co_sdo_cli *cli, const uint8_t *d)
 			}
 			memcpy(&cli->up_buf[cli->offset], &d[1], CO_SDO_SEG_SIZE);
 			if (cli->crc_on) {
-				cli->crc = co_sdo_crc16(cli->crc, &d[1], CO_SDO_SEG_SIZE);
+				cli->crc = crc16_itu_t(cli->crc, &d[1], CO_SDO_SEG_SIZE);
 			}
 			cli->offset += CO_SDO_SEG_SIZE;
 		}
@@ -549,7 +550,7 @@ static uint32_t blk_up_end(struct co_sdo_cli *cli, const uint8_t *d)
 		memcpy(&cli->up_buf[cli->offset], cli->last_seg, n);
 	}
 	if (cli->crc_on) {
-		cli->crc = co_sdo_crc16(cli->crc, cli->last_seg, n);
+		cli->crc = crc16_itu_t(cli->crc, cli->last_seg, n);
 		if (cli->crc != sys_get_le16(&d[1])) {
 			return CO_SDO_AB_CRC;
 		}

@@ -5,7 +5,7 @@
 
 /*
  * Pieces of the SDO protocol (CiA 301 §7.2.4.3) shared by the SDO server and client: the
- * layout of byte 0 of every SDO frame and the block-transfer CRC.
+ * layout of byte 0 of every SDO frame. The block-transfer CRC is Zephyr's crc16_itu_t().
  */
 
 #ifndef SAFELINE_SUBSYS_CANOPEN_SDO_SDO_INTERNAL_H_
@@ -111,19 +111,6 @@ extern "C" {
 /** Sub-block segment: sequence number 1..127. */
 #define CO_SDO_BLK_SEQNO(b)  ((b) & 0x7fU)
 /** @} */
-
-/**
- * @brief Continue a CRC-16 over @p len bytes (CiA 301 §7.2.4.3.16).
- *
- * CRC-16-CCITT: polynomial x^16 + x^12 + x^5 + 1 (1021h), not reflected, no final XOR. A
- * block transfer starts from 0000h; check value of "123456789" is 31C3h.
- *
- * @param crc  CRC so far (0 to start)
- * @param data bytes to add
- * @param len  number of bytes
- * @return the updated CRC
- */
-uint16_t co_sdo_crc16(uint16_t crc, const uint8_t *data, size_t len);
 
 #ifdef __cplusplus
 }

@@ -27,6 +27,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 #include <zephyr/sys/byteorder.h>
+#include <zephyr/sys/crc.h>
 #include <zephyr/sys/util.h>
 
 #include <canopen/cob_id.h>
@@ -509,7 +510,7 @@ static uint32_t blk_dn_segment(struct co_sdo_srv *srv, const uint8_t *d, uint64_
 				return code;
 			}
 			if (srv->crc_on) {
-				srv->crc = co_sdo_crc16(srv->crc, &d[1], CO_SDO_SEG_SIZE);
+				srv->crc = crc16_itu_t(srv->crc, &d[1], CO_SDO_SEG_SIZE);
 			}
 			srv->offset += CO_SDO_SEG_SIZE;
 		}
@@ -536,7 +537,7 @@ static uint32_t blk_dn_end(struct co_sdo_srv *srv, const uint8_t *d)
 	uint32_t code;
 
 	if (srv->crc_on) {
-		uint16_t crc = co_sdo_crc16(srv->crc, srv->tail, valid);
+		uint16_t crc = crc16_itu_t(srv->crc, srv->tail, valid);
 
 		if (crc != sys_get_le16(&d[1])) {
 			return CO_SDO_AB_CRC;
@@ -616,8 +617,8 @@ static uint32_t blk_up_send(struct co_sdo_srv *srv, uint64_t now)
 		/* The CRC covers every byte once, when it is first sent. */
 		if (o + len > srv->done) {
 			if (srv->crc_on) {
-				srv->crc = co_sdo_crc16(srv->crc, &r[1 + (srv->done - o)],
-							o + len - srv->done);
+				srv->crc = crc16_itu_t(srv->crc, &r[1 + (srv->done - o)],
+						       o + len - srv->done);
 			}
 			srv->done = o + len;
 		} else {

@@ -4,15 +4,15 @@
  */
 
 /*
- * CRC-16-CCITT of SDO block transfers (CiA 301 §7.2.4.3.16): polynomial 1021h, MSB first,
- * start value 0000h, no final XOR. One table lookup per byte keeps the per-segment cost low;
- * the table is const (flash on a target).
+ * Zephyr's crc16_itu_t() (<zephyr/sys/crc.h>): polynomial 1021h, MSB first, no reflection, no
+ * final XOR. CANopen uses it with seed 0 for SDO block transfers (CiA 301 §7.2.4.3.16) and the
+ * SRDO configuration signature (CiA 304). One table lookup per byte; the table is const.
  */
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sdo_internal.h"
+#include <zephyr/sys/crc.h>
 
 /* crc_table[i] = CRC of the byte i shifted through the polynomial (i << 8, 8 steps). */
 static const uint16_t crc_table[256] = {
@@ -44,10 +44,12 @@ static const uint16_t crc_table[256] = {
 	0x4e55U, 0x5e74U, 0x2e93U, 0x3eb2U, 0x0ed1U, 0x1ef0U,
 };
 
-uint16_t co_sdo_crc16(uint16_t crc, const uint8_t *data, size_t len)
+uint16_t crc16_itu_t(uint16_t seed, const uint8_t *src, size_t len)
 {
+	uint16_t crc = seed;
+
 	for (size_t i = 0; i < len; i++) {
-		crc = (uint16_t)((crc << 8) ^ crc_table[((crc >> 8) ^ data[i]) & 0xffU]);
+		crc = (uint16_t)((crc << 8) ^ crc_table[((crc >> 8) ^ src[i]) & 0xffU]);
 	}
 	return crc;
 }
