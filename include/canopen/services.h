@@ -40,6 +40,9 @@
 #if defined(CONFIG_CANOPEN_PDO) || defined(__DOXYGEN__)
 #include <canopen/pdo.h>
 #endif
+#if defined(CONFIG_CANOPEN_SRDO) || defined(__DOXYGEN__)
+#include <canopen/srdo.h>
+#endif
 #if defined(CONFIG_CANOPEN_SDO_SERVER) || defined(__DOXYGEN__)
 #include <canopen/sdo.h>
 #endif
@@ -52,8 +55,8 @@
 
 /*
  * The order is what a node does on the bus at a reset or state change: error control first
- * (a state change is announced by a heartbeat at once), then EMCY, SYNC, TIME, PDO, SDO; the
- * manager last, after the SDO clients its boot-up uses.
+ * (a state change is announced by a heartbeat at once), then EMCY, SYNC, TIME, PDO, SRDO,
+ * SDO; the manager last, after the SDO clients its boot-up uses.
  */
 /* clang-format off */
 #define CO_NODE_SERVICES(X)                                                                        \
@@ -62,6 +65,7 @@
 	IF_ENABLED(CONFIG_CANOPEN_SYNC, (X(sync, struct co_sync sync)))                            \
 	IF_ENABLED(CONFIG_CANOPEN_TIME, (X(time, struct co_time_svc time)))                        \
 	IF_ENABLED(CONFIG_CANOPEN_PDO, (X(pdo, struct co_pdo pdo)))                                \
+	IF_ENABLED(CONFIG_CANOPEN_SRDO, (X(srdo, struct co_srdo srdo)))                            \
 	IF_ENABLED(CONFIG_CANOPEN_SDO_SERVER,                                                      \
 		   (X(sdo_srv, struct co_sdo_srv sdo_srv[CONFIG_CANOPEN_SDO_SERVERS])))            \
 	IF_ENABLED(CONFIG_CANOPEN_SDO_CLIENT,                                                      \

@@ -429,9 +429,11 @@ static void error_behaviour(struct co_node *node, uint8_t sub)
 
 /* Another service's error (CO_EV_ERROR): raised once while present, cleared by its end. */
 static void service_error(struct co_node *node, uint16_t code, uint8_t reg_bits, uint8_t info,
-			  uint8_t flags)
+			  uint32_t detail, uint8_t flags)
 {
 	uint8_t msef[5] = {info};
+
+	co_od_le_put(&msef[1], 4, detail);
 
 	if ((flags & CO_ERROR_F_ACTIVE) == 0U) {
 		(void)clear_locked(node, code);
@@ -568,7 +570,7 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 	ARG_UNUSED(user_data);
 	if (ev->type == CO_EV_ERROR) {
 		service_error(node, ev->error.code, ev->error.reg_bits, ev->error.info,
-			      ev->error.flags);
+			      ev->error.detail, ev->error.flags);
 	}
 #if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
 	/* The controller state of the default line; a redundant line's state is the

@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: Apache-2.0
  */
 
+#include <errno.h>
 #include <string.h>
 
 #include <zephyr/ztest.h>
@@ -13,6 +14,9 @@ struct co_sim sim;
 
 static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
 {
+	if (sim.tx_busy) {
+		return -EAGAIN;
+	}
 	zassert_true(sim.n_sent < CO_SIM_MAX_TX, "too many frames");
 	sim.sent_at[sim.n_sent] = sim.now;
 	sim.sent[sim.n_sent++] = *frame;

@@ -12,6 +12,7 @@
 #ifndef SAFELINE_TESTS_CANOPEN_LIB_CO_SIM_H_
 #define SAFELINE_TESTS_CANOPEN_LIB_CO_SIM_H_
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -28,6 +29,8 @@ struct co_sim {
 	struct can_frame sent[CO_SIM_MAX_TX];
 	uint64_t sent_at[CO_SIM_MAX_TX];
 	int n_sent;
+	/* While set, the sink pushes back (-EAGAIN): frames wait in the line's TX queue. */
+	bool tx_busy;
 };
 
 extern struct co_sim sim;
