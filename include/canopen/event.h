@@ -80,8 +80,6 @@ enum co_event_type {
 	CO_EV_LINE,
 	/** The manager finished the boot of a slave, well or not (@ref co_event.boot). */
 	CO_EV_BOOT,
-	/** The node's LSS slave changed state (@ref co_event.lss, CiA 305). */
-	CO_EV_LSS,
 	/**
 	 * An SRDO the node consumes or produces entered or left the safe state
 	 * (@ref co_event.srdo, CiA 304).
@@ -89,14 +87,6 @@ enum co_event_type {
 	CO_EV_SRDO,
 	/** Number of event types. */
 	CO_EV_COUNT
-};
-
-/** LSS slave states (CiA 305 §4.4), as CO_EV_LSS reports them. */
-enum co_lss_state {
-	/** LSS waiting: the node runs normally (or waits for a node-ID when it has none). */
-	CO_LSS_STATE_WAITING,
-	/** LSS configuration: node-ID and bit timing may be configured. */
-	CO_LSS_STATE_CONFIGURATION,
 };
 
 /** Mask bit of one event type, for co_listener_init(). */
@@ -183,13 +173,6 @@ struct co_event {
 			/** CiA 302-2 error status: 0 booted, else 'A'..'O'. */
 			char status;
 		} boot;
-		/** CO_EV_LSS. */
-		struct {
-			enum co_lss_state from;
-			enum co_lss_state to;
-			/** A fastscan is in progress and this node takes part in it. */
-			bool fastscan;
-		} lss;
 		/** CO_EV_SRDO. */
 		struct {
 			/** SRDO number, 1..64. */
