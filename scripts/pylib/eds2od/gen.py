@@ -313,7 +313,9 @@ def count_macros(model: Model):
         "TPDO_MAP": n_in(0x1A00, 0x1BFF),
         "SDO_SRV": n_in(0x1200, 0x127F),
         "SDO_CLI": n_in(0x1280, 0x12FF),
-        "SRDO": n_in(0x1301, 0x1340),
+        # SRDO n lives at 1300h + n and the stack keeps n instances for SRDOs 1..n, so the
+        # count is the highest SRDO number (the same as the number of SRDOs without gaps).
+        "SRDO": max((o.index - 0x1300 for o in objs if 0x1301 <= o.index <= 0x1340), default=0),
         "HB_CONS": subs_of(0x1016),
         "EM_HIST": subs_of(0x1003),
         "EMCY_CONS": subs_of(0x1028),

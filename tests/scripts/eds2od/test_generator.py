@@ -160,16 +160,16 @@ def _with_client_sdo(eds, tmp_path):
     return path
 
 
-def _with_srdos(eds, tmp_path):
-    """io401.eds plus two disabled SRDOs, 1301h/1381h and 1302h/1382h (io401 has none)."""
+def _with_srdos(eds, tmp_path, numbers=(1, 2)):
+    """io401.eds plus disabled SRDOs (1300h + n with 1380h + n; io401 has none)."""
     text = open(eds, encoding="utf-8").read()
     m = re.search(r"\[OptionalObjects\]\nSupportedObjects=(\d+)\n", text)
     n = int(m.group(1))
-    idxs = [0x1301, 0x1302, 0x1381, 0x1382]
+    idxs = [0x1300 + k for k in numbers] + [0x1380 + k for k in numbers]
     text = text.replace(m.group(0), f"[OptionalObjects]\nSupportedObjects={n + len(idxs)}\n" +
                         "".join(f"{n + 1 + i}=0x{x:04X}\n" for i, x in enumerate(idxs)))
     srdos = "".join(srdo_comm(k, 0, 0, 0, 0, 0, 0) + srdo_map(k, [0, 0], count=0)
-                    for k in (1, 2))
+                    for k in numbers)
     text = text.replace("\n[1400]\n", "\n" + srdos + "[1400]\n", 1)
     path = tmp_path / "io_srdo.eds"
     path.write_text(text, encoding="utf-8")
@@ -201,3 +201,15 @@ def test_counts_checked_against_kconfig_only_with_the_service(tmp_path, key, sym
     assert r.returncode != 0
     assert f"more {key} objects than {sym}" in r.stderr
     assert _syntax_check(out, "io", [f"{sym}={n - 1}"]).returncode == 0, "service off"
+
+
+def test_srdo_count_is_the_highest_srdo_number(tmp_path):
+    """The stack keeps instances for SRDOs 1..n: a dictionary with only SRDO 3 needs three."""
+    out = tmp_path / "gen"
+    r = run_eds2od(_with_srdos(os.path.join(DATA, "io401.eds"), tmp_path, (3,)), out, "io")
+    assert r.returncode == 0, r.stderr
+    assert _count((out / "io_od.h").read_text(), "io", "SRDO") == 3
+    guard = "CONFIG_CANOPEN_SRDO=1"
+    assert _syntax_check(out, "io", [guard, "CONFIG_CANOPEN_SRDOS=3"]).returncode == 0
+    r = _syntax_check(out, "io", [guard, "CONFIG_CANOPEN_SRDOS=2"])
+    assert r.returncode != 0 and "more SRDO objects than CONFIG_CANOPEN_SRDOS" in r.stderr
