@@ -8,10 +8,11 @@
  *
  * The bus is a small discrete-event simulation. Events, in this order when they fall on the
  * same instant: end of the frame on the bus (delivery, then TX completion), end of a bus-off
- * recovery, a latency-delayed delivery, start of the next frame (arbitration among frames
- * queued by then). In real-time mode a thread per bus processes events as the uptime clock
- * reaches them and sleeps until the next one (woken early by new frames). In simulated mode
- * the test moves one global clock and events run in its thread, in time order across buses.
+ * recovery, a delayed delivery (receiver latency or a delay fault), start of the next frame
+ * (arbitration among frames queued by then). In real-time mode a thread per bus processes events as
+ * the uptime clock reaches them and sleeps until the next one (woken early by new frames). In
+ * simulated mode the test moves one global clock and events run in its thread, in time order across
+ * buses.
  *
  * Locking: one mutex (cv_lock) guards all bus and controller state; it is never held while a
  * callback runs. Each controller's rx_lock is held while its receive callbacks run and while
@@ -97,6 +98,7 @@ enum cv_fault_type {
 	CV_FAULT_NONE,
 	CV_FAULT_DROP,
 	CV_FAULT_CORRUPT,
+	CV_FAULT_DELAY,
 };
 
 struct cv_fault {
@@ -104,6 +106,7 @@ struct cv_fault {
 	struct can_filter filter;
 	uint32_t remaining;
 	uint8_t xor_mask[CAN_MAX_DLEN];
+	uint32_t delay_us;
 };
 
 struct cv_delayed {
@@ -337,9 +340,13 @@ static bool cv_delay_locked(struct cv_bus *b, uint8_t ctrl, uint64_t due_ns,
 	return false;
 }
 
-/* Applies the first matching fault. Returns false if the frame is lost. */
-static bool cv_apply_faults_locked(struct cv_bus *b, struct can_frame *frame)
+/*
+ * Applies the first matching fault. Returns false if the frame is lost; *delay_ns gets the
+ * time every receiver gets it later (0 for none).
+ */
+static bool cv_apply_faults_locked(struct cv_bus *b, struct can_frame *frame, uint64_t *delay_ns)
 {
+	*delay_ns = 0U;
 	for (int i = 0; i < CV_MAX_FAULTS; i++) {
 		struct cv_fault *f = &b->faults[i];
 
@@ -354,6 +361,11 @@ static bool cv_apply_faults_locked(struct cv_bus *b, struct can_frame *frame)
 		if (type == CV_FAULT_DROP) {
 			b->stats.dropped++;
 			return false;
+		}
+		if (type == CV_FAULT_DELAY) {
+			*delay_ns = (uint64_t)f->delay_us * 1000U;
+			b->stats.delayed++;
+			return true;
 		}
 		if ((frame->flags & CAN_FRAME_RTR) == 0U) {
 			for (int k = 0; k < frame->dlc && k < (int)CAN_MAX_DLEN; k++) {
@@ -548,6 +560,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 		struct cv_data *now_rx[CV_NUM_CTRL];
 		int n_rx = 0;
 		const bool loopback = (src->common.mode & CAN_MODE_LOOPBACK) != 0U;
+		uint64_t delay_ns = 0U;
 		bool lost = false;
 
 		b->busy = false;
@@ -562,7 +575,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 			memset(frame.data, 0, sizeof(frame.data));
 		}
 		if (!loopback) {
-			lost = !cv_apply_faults_locked(b, &frame);
+			lost = !cv_apply_faults_locked(b, &frame, &delay_ns);
 		}
 		for (int i = 0; !lost && i < CV_NUM_CTRL; i++) {
 			struct cv_data *d = cv_data(cv_devs[i]);
@@ -572,10 +585,11 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 			    d->bitrate != src->bitrate) {
 				continue;
 			}
-			if (d->latency_us == 0U) {
+			/* A delayed frame adds to the receiver's own latency. */
+			if (d->latency_us == 0U && delay_ns == 0U) {
 				now_rx[n_rx++] = d;
 			} else {
-				uint64_t due = t + (uint64_t)d->latency_us * 1000U;
+				uint64_t due = t + delay_ns + (uint64_t)d->latency_us * 1000U;
 				struct can_frame late = frame;
 
 				cv_stamp(&late, due);
@@ -881,7 +895,7 @@ static bool cv_bus_ok(int bus)
 }
 
 static int cv_add_fault(int bus, enum cv_fault_type type, const struct can_filter *filter,
-			uint32_t count, const uint8_t *xor_mask)
+			uint32_t count, const uint8_t *xor_mask, uint32_t delay_us)
 {
 	int rc = -ENOSPC;
 
@@ -900,6 +914,7 @@ static int cv_add_fault(int bus, enum cv_fault_type type, const struct can_filte
 			if (xor_mask != NULL) {
 				memcpy(f->xor_mask, xor_mask, sizeof(f->xor_mask));
 			}
+			f->delay_us = delay_us;
 			rc = 0;
 			break;
 		}
@@ -911,7 +926,7 @@ static int cv_add_fault(int bus, enum cv_fault_type type, const struct can_filte
 
 int can_virtual_drop_frames(int bus, const struct can_filter *filter, uint32_t count)
 {
-	return cv_add_fault(bus, CV_FAULT_DROP, filter, count, NULL);
+	return cv_add_fault(bus, CV_FAULT_DROP, filter, count, NULL, 0U);
 }
 
 int can_virtual_corrupt_frames(int bus, const struct can_filter *filter, uint32_t count,
@@ -921,7 +936,17 @@ int can_virtual_corrupt_frames(int bus, const struct can_filter *filter, uint32_
 		return -EINVAL;
 	}
 
-	return cv_add_fault(bus, CV_FAULT_CORRUPT, filter, count, xor_mask);
+	return cv_add_fault(bus, CV_FAULT_CORRUPT, filter, count, xor_mask, 0U);
+}
+
+int can_virtual_delay_frames(int bus, const struct can_filter *filter, uint32_t count,
+			     uint32_t delay_us)
+{
+	if (delay_us == 0U) {
+		return -EINVAL;
+	}
+
+	return cv_add_fault(bus, CV_FAULT_DELAY, filter, count, NULL, delay_us);
 }
 
 int can_virtual_clear_faults(int bus)

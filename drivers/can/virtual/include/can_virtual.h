@@ -50,6 +50,8 @@ struct can_virtual_bus_stats {
 	uint32_t dropped;
 	/** Frames altered by can_virtual_corrupt_frames(). */
 	uint32_t corrupted;
+	/** Frames held back by can_virtual_delay_frames(). */
+	uint32_t delayed;
 	/** Deliveries lost because the latency queue was full. */
 	uint32_t delay_overflows;
 	/** Time the bus was occupied by frames, in ns (bit timing on only). */
@@ -84,7 +86,28 @@ int can_virtual_drop_frames(int bus, const struct can_filter *filter, uint32_t c
 int can_virtual_corrupt_frames(int bus, const struct can_filter *filter, uint32_t count,
 			       const uint8_t xor_mask[CAN_MAX_DLEN]);
 
-/** @brief Remove the drop and corrupt faults of @p bus that have not run out. */
+/**
+ * @brief Deliver the next @p count frames on @p bus that match @p filter @p delay_us
+ *        microseconds late to every receiver; senders get their TX completion at the end of
+ *        the frame on the bus, as usual.
+ *
+ * Each receiver gets the frame (and its receive timestamp) at the end of the frame plus
+ * @p delay_us plus its own latency (can_virtual_set_latency()). Frames that are not delayed
+ * are not held back by it: they overtake a delayed frame. Works with both clocks; a delivery
+ * that finds the bus's delay queue (CONFIG_CAN_VIRTUAL_DELAY_QUEUE_SIZE) full is lost for that
+ * receiver and counted in delay_overflows. Faults are checked in the order they were added;
+ * the first that matches a frame applies.
+ *
+ * @retval -EINVAL Bad bus, no filter, @p count or @p delay_us 0.
+ * @retval -ENOSPC The bus's fault table is full.
+ */
+int can_virtual_delay_frames(int bus, const struct can_filter *filter, uint32_t count,
+			     uint32_t delay_us);
+
+/**
+ * @brief Remove the drop, corrupt and delay faults of @p bus that have not run out (frames
+ *        already held back by a delay still arrive).
+ */
 int can_virtual_clear_faults(int bus);
 
 /**

@@ -464,6 +464,59 @@ ZTEST(can_virtual, test_latency)
 	zassert_equal(got[0]->frame.timestamp, (uint16_t)(t0 + 500));
 }
 
+ZTEST(can_virtual, test_delay_frames)
+{
+	const struct can_filter flt = {.id = 0x41, .mask = CAN_STD_ID_MASK};
+	struct can_virtual_bus_stats s0;
+	struct can_virtual_bus_stats s1;
+	struct rx_rec *got[16];
+	uint64_t t0 = can_virtual_time_us();
+
+	zassert_equal(can_virtual_delay_frames(0, &flt, 1, 0), -EINVAL, "a delay of 0");
+	zassert_equal(can_virtual_delay_frames(0, &flt, 0, 300), -EINVAL, "a count of 0");
+	zassert_equal(can_virtual_delay_frames(2, &flt, 1, 300), -EINVAL, "no bus 2");
+	zassert_equal(can_virtual_delay_frames(0, NULL, 1, 300), -EINVAL);
+	zassert_ok(can_virtual_bus_get_stats(0, &s0));
+	zassert_ok(can_virtual_set_latency(c[2], 100));
+	zassert_ok(can_virtual_delay_frames(0, &flt, 1, 300));
+	queue(0, &(struct can_frame){.id = 0x41, .dlc = 1, .data = {1}});
+	queue(0, &(struct can_frame){.id = 0x41, .dlc = 1, .data = {2}});
+	zassert_equal(can_virtual_sim_advance(0), 2);
+	zassert_equal(n_tx, 2, "the sender completes at the end of the frame");
+	zassert_equal(tx_log[0].t_us, t0);
+	zassert_equal(rx_of(1, got, 16), 1, "the second frame overtakes the delayed one");
+	zassert_equal(got[0]->frame.data[0], 2);
+
+	zassert_equal(can_virtual_sim_advance(100), 0);
+	zassert_equal(rx_of(2, got, 16), 1, "c2: the undelayed frame after its own latency");
+	zassert_equal(got[0]->frame.data[0], 2);
+	zassert_equal(can_virtual_sim_advance(199), 0);
+	zassert_equal(rx_of(1, got, 16), 1, "not yet");
+	can_virtual_sim_advance(1);
+	zassert_equal(rx_of(1, got, 16), 2);
+	zassert_equal(got[1]->frame.data[0], 1);
+	zassert_equal(got[1]->t_us, t0 + 300);
+	zassert_equal(got[1]->frame.timestamp, (uint16_t)(t0 + 300), "stamped when delivered");
+	zassert_equal(rx_of(2, got, 16), 1, "c2 adds its latency of 100 us");
+	can_virtual_sim_advance(100);
+	zassert_equal(rx_of(2, got, 16), 2);
+	zassert_equal(got[1]->frame.data[0], 1);
+	zassert_equal(got[1]->t_us, t0 + 400);
+
+	/* Used up: the next frame is on time. Unused delays go with the other faults. */
+	zassert_ok(can_virtual_set_latency(c[2], 0));
+	queue(0, &(struct can_frame){.id = 0x41, .dlc = 1, .data = {3}});
+	zassert_equal(can_virtual_sim_advance(0), 1);
+	zassert_equal(rx_of(1, got, 16), 3);
+	zassert_ok(can_virtual_delay_frames(0, &flt, 5, 300));
+	zassert_ok(can_virtual_clear_faults(0));
+	queue(0, &(struct can_frame){.id = 0x41, .dlc = 1, .data = {4}});
+	zassert_equal(can_virtual_sim_advance(0), 1);
+	zassert_equal(rx_of(1, got, 16), 4);
+	zassert_ok(can_virtual_bus_get_stats(0, &s1));
+	zassert_equal(s1.delayed - s0.delayed, 1);
+}
+
 ZTEST(can_virtual, test_error_warning_and_passive)
 {
 	struct can_bus_err_cnt cnt;
@@ -690,6 +743,35 @@ ZTEST(can_virtual, test_realtime_respects_the_physical_limit)
 		     (unsigned int)bits, (long long)elapsed_us);
 	zassert_equal(can_virtual_sim_advance(1), -ENOTSUP);
 	zassert_equal(can_virtual_sim_run(1), -ENOTSUP);
+}
+
+ZTEST(can_virtual, test_realtime_delay_frames)
+{
+	const struct can_filter flt = {.id = 0x42, .mask = CAN_STD_ID_MASK};
+	struct rx_rec *got[16];
+	uint64_t t0;
+
+	zassert_ok(can_virtual_delay_frames(0, &flt, 1, 20000));
+	k_sem_init(&done_sem, 0, 2);
+	t0 = can_virtual_time_us();
+	zassert_ok(can_send(c[0], &(struct can_frame){.id = 0x42, .dlc = 1, .data = {1}}, K_FOREVER,
+			    done_cb, NULL));
+	zassert_ok(can_send(c[0], &(struct can_frame){.id = 0x43, .dlc = 1, .data = {2}}, K_FOREVER,
+			    done_cb, NULL));
+	zassert_ok(k_sem_take(&done_sem, K_SECONDS(10)));
+	zassert_ok(k_sem_take(&done_sem, K_SECONDS(10)));
+	for (int i = 0; i < 300 && rx_of(1, got, 16) < 2; i++) {
+		k_msleep(1);
+	}
+	zassert_equal(rx_of(1, got, 16), 2);
+	zassert_equal(got[0]->frame.id, 0x43, "the undelayed frame first");
+	zassert_equal(got[1]->frame.id, 0x42);
+	zassert_true(got[0]->t_us - t0 < 20000U, "0x43 on time (%u us)",
+		     (unsigned int)(got[0]->t_us - t0));
+	zassert_true(got[1]->t_us - t0 >= 20000U, "0x42 held back 20 ms (%u us)",
+		     (unsigned int)(got[1]->t_us - t0));
+	zassert_true((uint16_t)(got[1]->frame.timestamp - (uint16_t)t0) >= 20000U,
+		     "stamped when delivered");
 }
 
 ZTEST(can_virtual, test_realtime_bus_off_recovers)
