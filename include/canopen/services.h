@@ -52,11 +52,15 @@
 #if defined(CONFIG_CANOPEN_MGR) || defined(__DOXYGEN__)
 #include <canopen/mgr.h>
 #endif
+#if defined(CONFIG_CANOPEN_LEDS) || defined(__DOXYGEN__)
+#include <canopen/leds.h>
+#endif
 
 /*
  * The order is what a node does on the bus at a reset or state change: error control first
  * (a state change is announced by a heartbeat at once), then EMCY, SYNC, TIME, PDO, SRDO,
- * SDO; the manager last, after the SDO clients its boot-up uses.
+ * SDO; the manager after the SDO clients its boot-up uses; the indicators, which only listen,
+ * last.
  */
 /* clang-format off */
 #define CO_NODE_SERVICES(X)                                                                        \
@@ -70,7 +74,8 @@
 		   (X(sdo_srv, struct co_sdo_srv sdo_srv[CONFIG_CANOPEN_SDO_SERVERS])))            \
 	IF_ENABLED(CONFIG_CANOPEN_SDO_CLIENT,                                                      \
 		   (X(sdo_cli, struct co_sdo_cli sdo_cli[CONFIG_CANOPEN_SDO_CLIENTS])))            \
-	IF_ENABLED(CONFIG_CANOPEN_MGR, (X(mgr, struct co_mgr mgr)))
+	IF_ENABLED(CONFIG_CANOPEN_MGR, (X(mgr, struct co_mgr mgr)))                                \
+	IF_ENABLED(CONFIG_CANOPEN_LEDS, (X(leds, struct co_leds leds)))
 /* clang-format on */
 
 #endif /* SAFELINE_INCLUDE_CANOPEN_SERVICES_H_ */
