@@ -164,7 +164,7 @@ class Lint:
         if direction:
             self.comm_values(n, comm, direction)
             if count is not None:
-                self.mapping_values(n, mapping, count)
+                self.mapping_values(n, mapping, count, direction)
 
     def comm(self, n, o) -> Optional[int]:
         """Structural checks of a communication record; its direction, None if unusable."""
@@ -289,7 +289,7 @@ class Lint:
             ok = False
         return count if ok else None
 
-    def mapping_values(self, n, o, count):
+    def mapping_values(self, n, o, count, direction):
         idx = o.index
         subs = {s.sub: s for s in o.subs}
         size = {}  # k -> bytes, for the entries that are right
@@ -318,13 +318,22 @@ class Lint:
                 self.err(line, f"{what} maps {ti:04X}h:{ts}, which is not mappable "
                                "(PDOMapping=0)")
                 bad = True
+            elif direction == 1 and not ts_obj.tpdo:
+                self.err(line, f"{what} maps {ti:04X}h:{ts} ({ts_obj.access}) into a "
+                               "producer, which must read it")
+                bad = True
+            elif direction == 2 and not ts_obj.rpdo:
+                self.err(line, f"{what} maps {ti:04X}h:{ts} ({ts_obj.access}) into a "
+                               "consumer, which must write it")
+                bad = True
             if bits == 0 or bits % 8:
                 self.err(line, f"{what} maps {bits} bits of {ti:04X}h:{ts}; SRDO entries are "
                                "whole bytes")
                 continue
-            if bits > 8 * ts_obj.size:
+            if bits != 8 * ts_obj.size:
                 self.err(line, f"{what} maps {bits} bits of {ti:04X}h:{ts}, which has "
-                               f"{8 * ts_obj.size} ({ts_obj.dtype.name})")
+                               f"{8 * ts_obj.size} ({ts_obj.dtype.name}); an SRDO maps whole "
+                               "objects")
                 bad = True
             if not bad:
                 size[k] = bits // 8

@@ -570,13 +570,35 @@ def test_srdo_mapping_not_whole_bytes(tmp_path):
 def test_srdo_mapping_longer_than_object(tmp_path):
     body = srdo_body(map1=srdo_map(1, [0x62000110, 0x62010110]))
     expect(tmp_path, srdo_eds(body), "DefaultValue=0x62000110",
-           "maps 16 bits of 6200h:1, which has 8 (UNSIGNED8)")
+           "maps 16 bits of 6200h:1, which has 8 (UNSIGNED8); an SRDO maps whole objects")
 
 
 def test_srdo_mapping_partner_length(tmp_path):
-    body = srdo_body(map2=srdo_map(2, [0x64010110, 0x64020108]))
-    expect(tmp_path, srdo_eds(body), "DefaultValue=0x64020108",
-           "1382h:2: the inverted entry maps 8 bits, its normal partner 1382h:1 maps 16")
+    body = srdo_body(map2=srdo_map(2, [0x64010110, 0x62000108]))
+    expect_key(tmp_path, srdo_eds(body), "1382sub2", "DefaultValue",
+               "1382h:2: the inverted entry maps 8 bits, its normal partner 1382h:1 maps 16")
+
+
+def test_srdo_mapping_part_of_an_object(tmp_path):
+    # The stack maps whole objects only (a consumer writes, a producer reads whole values).
+    body = srdo_body(map2=srdo_map(2, [0x64010108, 0x64020108]))
+    expect(tmp_path, srdo_eds(body), "DefaultValue=0x64010108",
+           "maps 8 bits of 6401h:1, which has 16 (UNSIGNED16); an SRDO maps whole objects")
+
+
+def test_srdo_consumer_maps_read_only_object(tmp_path):
+    body = srdo_body(app=app_array(0x6200, 2) + app_array(0x6201, 2) +
+                     app_array(0x6401, 2, "0x0006", access="ro") +
+                     app_array(0x6402, 2, "0x0006"))
+    expect(tmp_path, srdo_eds(body), "DefaultValue=0x64010110",
+           "maps 6401h:1 (ro) into a consumer, which must write it")
+
+
+def test_srdo_producer_maps_write_only_object(tmp_path):
+    body = srdo_body(app=app_array(0x6200, 2, access="wo") + app_array(0x6201, 2) +
+                     app_array(0x6401, 2, "0x0006") + app_array(0x6402, 2, "0x0006"))
+    expect(tmp_path, srdo_eds(body), "DefaultValue=0x62000108",
+           "maps 6200h:1 (wo) into a producer, which must read it")
 
 
 def test_srdo_mapping_more_than_8_bytes(tmp_path):
