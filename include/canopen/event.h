@@ -85,6 +85,11 @@ enum co_event_type {
 	 * (@ref co_event.srdo, CiA 304).
 	 */
 	CO_EV_SRDO,
+	/**
+	 * The node's LSS slave changed state, waiting or configuration (@ref co_event.lss,
+	 * CiA 305).
+	 */
+	CO_EV_LSS,
 	/** Number of event types. */
 	CO_EV_COUNT
 };
@@ -184,6 +189,19 @@ struct co_event {
 			/** When the fault was detected (or the SRDO became valid) [µs]. */
 			uint64_t time_us;
 		} srdo;
+		/** CO_EV_LSS. */
+		struct {
+			/** LSS state before (enum co_lss_state of canopen/lss.h). */
+			uint8_t from;
+			/** LSS state now. */
+			uint8_t to;
+			/**
+			 * A fastscan is in progress for this node: it answered the fastscan
+			 * probe and the scan has not ended for it, or this change ends it (the
+			 * scan selected the node).
+			 */
+			bool fastscan;
+		} lss;
 	};
 };
 
