@@ -94,12 +94,23 @@ struct co_errctl {
 	uint16_t guard_time_ms;
 	uint8_t life_factor;
 	uint8_t toggle;
+	/* co_hb_hold(): the heartbeat producer is silent. */
+	bool hb_held;
 	bool guarded;
 	bool life_lost;
 	co_life_ind_t life_ind;
 	void *life_user_data;
 };
 /** @endcond */
+
+/**
+ * @brief Hold the heartbeat producer silent, or let it send again.
+ *
+ * While held, 1017h's cadence runs on but no heartbeat goes out, so the node's consumers
+ * see it lost. The redundancy service holds it when TPDO 1 fails too often (CiA 302-6), so
+ * that the other nodes leave the line. A reset does not release it.
+ */
+void co_hb_hold(struct co_node *node, bool hold);
 
 /** @brief Set the heartbeat consumer indication (NULL removes it). */
 void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data);

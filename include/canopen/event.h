@@ -90,6 +90,13 @@ enum co_event_type {
 	 * CiA 305).
 	 */
 	CO_EV_LSS,
+	/** A TPDO was handed to the node's lines, or could not be (@ref co_event.tpdo). */
+	CO_EV_TPDO,
+	/**
+	 * The redundancy service saw something of the node's two lines: a heartbeat lost or
+	 * found on one line, a line switch, a vetoed switch (@ref co_event.redundancy).
+	 */
+	CO_EV_REDUNDANCY,
 	/** Number of event types. */
 	CO_EV_COUNT
 };
@@ -178,6 +185,24 @@ struct co_event {
 			/** CiA 302-2 error status: 0 booted, else 'A'..'O'. */
 			char status;
 		} boot;
+		/** CO_EV_TPDO. */
+		struct {
+			/** TPDO number (0 = 1800h). */
+			uint16_t num;
+			/** 0, or co_node_send()'s error: the frame did not reach every line. */
+			int err;
+		} tpdo;
+		/** CO_EV_REDUNDANCY. */
+		struct {
+			/** What happened (enum co_rdn_event of canopen/redundancy.h). */
+			uint8_t what;
+			/** The line concerned, or the new active line (enum co_node_line_id). */
+			uint8_t line;
+			/** The remote node concerned, 0 if none. */
+			uint8_t node_id;
+			/** When [µs, node time]. */
+			uint64_t time_us;
+		} redundancy;
 		/** CO_EV_SRDO. */
 		struct {
 			/** SRDO number, 1..64. */

@@ -74,6 +74,12 @@ typedef uint8_t co_route_t;
 #define CO_ROUTE_BOTH      (CO_ROUTE_DEFAULT | CO_ROUTE_REDUNDANT)
 /** The node's active line: the default line unless co_node_set_active_line() chose another. */
 #define CO_ROUTE_ACTIVE    BIT(7)
+/**
+ * The lines a node's process data, emergencies, SYNC/TIME it produces and its heartbeat go
+ * on: every line it has unless co_node_set_process_route() chose otherwise (CiA 302-6 sends
+ * them on both lines; the ECSS profile of the redundancy service on the active line alone).
+ */
+#define CO_ROUTE_PROCESS   BIT(6)
 /** @} */
 
 /** @cond INTERNAL_HIDDEN */
@@ -96,6 +102,10 @@ struct co_node {
 	const char *name;
 	struct co_node_line lines[CO_NODE_LINES];
 	uint8_t active_line;
+	/* The line the frame being dispatched came on (co_node_rx_line()). */
+	uint8_t rx_line;
+	/* What CO_ROUTE_PROCESS means (co_node_set_process_route()). */
+	co_route_t process_route;
 	struct co_od od;
 	uint8_t node_id;
 	/* Node-ID to use from the next Reset Communication (LSS may change it). */
@@ -239,7 +249,7 @@ static inline int co_node_send(struct co_node *node, co_route_t route,
 			       const struct can_frame *frame)
 {
 	if (node->lines[CO_LINE_REDUNDANT].line == NULL &&
-	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE)) != 0U) {
+	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE | CO_ROUTE_PROCESS)) != 0U) {
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
 		co_node_assert_locked(node);
 #endif
@@ -248,8 +258,52 @@ static inline int co_node_send(struct co_node *node, co_route_t route,
 	return co_node_send_routed(node, route, frame);
 }
 
-/** @brief The route that answers a frame received by @p rx (the line it came on). */
+/**
+ * @brief The route that answers a frame received by @p rx: the line it came on.
+ *
+ * Call from the receiver's handler. A frame of the redundant line handed over by
+ * co_node_dispatch_from() is answered there.
+ */
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx);
+
+/**
+ * @brief The line the frame being handled came on (enum co_node_line_id).
+ *
+ * Call from a receiver's handler (CO_LINE_DEFAULT outside one, and always on a node with one
+ * line). A service that acts on a frame from the active line only (SYNC, TIME) compares it
+ * with co_node_active_line().
+ */
+static inline uint8_t co_node_rx_line(const struct co_node *node)
+{
+	return node->rx_line;
+}
+
+/** @brief The node's active line (enum co_node_line_id). */
+static inline uint8_t co_node_active_line(const struct co_node *node)
+{
+	return node->active_line;
+}
+
+/**
+ * @brief Hand a frame that came on line @p idx to the node's receivers of the default line.
+ *
+ * For the redundancy service: one catch-all receiver on the redundant line brings its frames
+ * to the node's services, which then hear both lines through the receivers they registered on
+ * the default line; co_node_rx_line() tells them where a frame came from. Requires the node's
+ * mutex (a receiver's handler holds it).
+ *
+ * @return Number of receivers called.
+ */
+int co_node_dispatch_from(struct co_node *node, enum co_node_line_id idx,
+			  const struct can_frame *frame, uint64_t now_us);
+
+/**
+ * @brief Choose what CO_ROUTE_PROCESS means (CO_ROUTE_BOTH, or CO_ROUTE_ACTIVE).
+ *
+ * @retval 0 Done.
+ * @retval -EINVAL Another route.
+ */
+int co_node_set_process_route(struct co_node *node, co_route_t route);
 
 /**
  * @brief Free places in the TX queues of a route (the smallest of its lines).

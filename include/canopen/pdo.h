@@ -146,6 +146,13 @@ struct co_rpdo {
 	uint8_t mpdo;         /* 0, or CO_MPDO_SAM/CO_MPDO_DAM (mapping sub 0) */
 	bool present;
 	bool sync_pending;
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	/* The last frame accepted, to drop its copy from the other line (redundancy). */
+	uint64_t last_at;
+	uint8_t last_data[8];
+	uint8_t last_dlc;
+	uint8_t last_line;
+#endif
 };
 
 struct co_tpdo {
@@ -189,8 +196,21 @@ struct co_pdo {
 	struct co_mpdo_stats mpdo_stats;
 	/* SYNC reaches the PDOs as a node event. */
 	struct co_listener sync_listener;
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	/* RPDO frames dropped as the other line's copy of a frame already taken. */
+	uint32_t rx_duplicates;
+#endif
 };
 /** @endcond */
+
+/**
+ * @brief RPDO frames dropped as copies from the other line (redundancy, CiA 302-6).
+ *
+ * A node on two lines hears each PDO twice; the copy that arrives on the other line within
+ * CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US with the same data is dropped, so the application
+ * sees every value once. Always 0 without CONFIG_CANOPEN_REDUNDANCY.
+ */
+uint32_t co_pdo_rx_duplicates(struct co_node *node);
 
 /**
  * @brief Request the transmission of a TPDO (an application event).

@@ -28,6 +28,9 @@
 #include <zephyr/sys/util_macro.h>
 
 #include <canopen/errctl.h>
+#if defined(CONFIG_CANOPEN_REDUNDANCY) || defined(__DOXYGEN__)
+#include <canopen/redundancy.h>
+#endif
 #if defined(CONFIG_CANOPEN_LSS) || defined(__DOXYGEN__)
 #include <canopen/lss.h>
 #endif
@@ -62,13 +65,15 @@
 /*
  * The order is what a node does on the bus at a reset or state change: LSS before all (it
  * runs while the node has no node-ID, and a reset returns it to waiting before anything else
- * is configured), error control next (a state change is announced by a heartbeat at once),
+ * is configured), the line choice of a node on two lines (set before anything is sent), error
+ * control next (a state change is announced by a heartbeat at once),
  * then EMCY, SYNC, TIME, PDO, SRDO, SDO; the manager after the SDO clients its boot-up uses;
  * the indicators, which only listen, last.
  */
 /* clang-format off */
 #define CO_NODE_SERVICES(X)                                                                        \
 	IF_ENABLED(CONFIG_CANOPEN_LSS, (X(lss, struct co_lss lss)))                                \
+	IF_ENABLED(CONFIG_CANOPEN_REDUNDANCY, (X(redundancy, struct co_redundancy rdn)))           \
 	X(errctl, struct co_errctl ec)                                                             \
 	IF_ENABLED(CONFIG_CANOPEN_EMCY, (X(emcy, struct co_emcy emcy)))                            \
 	IF_ENABLED(CONFIG_CANOPEN_SYNC, (X(sync, struct co_sync sync)))                            \

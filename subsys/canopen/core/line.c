@@ -418,6 +418,14 @@ int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now
 int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
 		     const struct k_mutex *origin)
 {
+	return co_line_dispatch_sel(line, frame, now_us, origin, false);
+}
+
+int co_line_dispatch_sel(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
+			 const struct k_mutex *lock, bool only)
+{
+	/* only: the receivers of @p lock alone; else every receiver but those of @p lock. */
+	const struct k_mutex *origin = only ? NULL : lock;
 	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
 	struct co_rx *batch[CONFIG_CANOPEN_LINE_RX_FANOUT];
 	int n = 0;
@@ -432,17 +440,18 @@ int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64
 
 		for (struct co_rx *rx = slot != 0U ? line->slots[slot - 1U] : NULL; rx != NULL;
 		     rx = rx->next) {
-			if (origin == NULL || rx->lock != origin) {
+			if (only ? rx->lock == lock : (origin == NULL || rx->lock != origin)) {
 				batch_add(line, batch, &n, rx);
 			}
 		}
 	}
 	for (struct co_rx *rx = line->others; rx != NULL; rx = rx->next) {
-		if (rx_matches(rx, frame, ext) && (origin == NULL || rx->lock != origin)) {
+		if (rx_matches(rx, frame, ext) &&
+		    (only ? rx->lock == lock : (origin == NULL || rx->lock != origin))) {
 			batch_add(line, batch, &n, rx);
 		}
 	}
-	if (origin == NULL) {
+	if (origin == NULL && !only) {
 		line->stats.rx_frames++;
 		if (n == 0) {
 			line->stats.rx_unhandled++;

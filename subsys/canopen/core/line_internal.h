@@ -39,6 +39,15 @@ void co_line_tx_drain(struct co_line *line);
 int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
 		     const struct k_mutex *origin);
 
+/*
+ * Dispatch @p frame to the receivers of @p lock only (@p only true), or to all but them (false,
+ * as co_line_dispatch() with @p lock as origin). A node on two lines hands the frames of its
+ * redundant line to its own receivers this way (co_node_dispatch_from()); it is not counted
+ * as a received frame of @p line.
+ */
+int co_line_dispatch_sel(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
+			 const struct k_mutex *lock, bool only);
+
 /* Simulation: dispatch the frames waiting for local delivery. */
 void co_line_local_drain(struct co_line *line);
 

@@ -18,6 +18,7 @@
 
 #include <canopen/node.h>
 
+#include "line_internal.h"
 #include "node_internal.h"
 
 LOG_MODULE_REGISTER(co_node, CONFIG_CANOPEN_LOG_LEVEL);
@@ -261,7 +262,7 @@ static void send_bootup(struct co_node *node)
 		.data = {0U},
 	};
 
-	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+	(void)co_node_send(node, CO_ROUTE_PROCESS, &f);
 }
 
 /*
@@ -497,6 +498,9 @@ int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
 
 static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
 {
+	if ((route & CO_ROUTE_PROCESS) != 0U) {
+		route = (co_route_t)((route & ~CO_ROUTE_PROCESS) | node->process_route);
+	}
 	if ((route & CO_ROUTE_ACTIVE) != 0U) {
 		route = (co_route_t)((route & ~CO_ROUTE_ACTIVE) | BIT(node->active_line));
 	}
@@ -540,10 +544,38 @@ void co_node_assert_locked(const struct co_node *node)
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx)
 {
 	/* rx->line is stable while the receiver's handler runs (it holds the node's mutex). */
-	return (node->lines[CO_LINE_REDUNDANT].line != NULL &&
+	if (node->lines[CO_LINE_REDUNDANT].line == NULL) {
+		return CO_ROUTE_DEFAULT;
+	}
+	return (node->rx_line == CO_LINE_REDUNDANT ||
 		rx->line == node->lines[CO_LINE_REDUNDANT].line)
 		       ? CO_ROUTE_REDUNDANT
 		       : CO_ROUTE_DEFAULT;
+}
+
+int co_node_dispatch_from(struct co_node *node, enum co_node_line_id idx,
+			  const struct can_frame *frame, uint64_t now_us)
+{
+	uint8_t outer = node->rx_line;
+	int n;
+
+	CO_ASSERT_LOCKED(&node->lock);
+	node->rx_line = (uint8_t)idx;
+	n = co_line_dispatch_sel(node->lines[CO_LINE_DEFAULT].line, frame, now_us, &node->lock,
+				 true);
+	node->rx_line = outer;
+	return n;
+}
+
+int co_node_set_process_route(struct co_node *node, co_route_t route)
+{
+	if (route != CO_ROUTE_BOTH && route != CO_ROUTE_ACTIVE) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	node->process_route = route;
+	co_node_unlock(node);
+	return 0;
 }
 
 int co_node_tx_space(struct co_node *node, co_route_t route)
@@ -603,6 +635,7 @@ int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
 	node->node_id = node_id;
 	node->pending_node_id = node_id;
 	node->nmt.state = CO_NMT_INITIALISING;
+	node->process_route = CO_ROUTE_BOTH;
 	node->services = services;
 	node->n_services = (uint8_t)n_services;
 	sys_slist_init(&node->listeners);

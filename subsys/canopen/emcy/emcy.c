@@ -116,7 +116,7 @@ static void transmit(struct co_node *node, const uint8_t data[8], uint64_t now_u
 	};
 
 	memcpy(f.data, data, 8);
-	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+	(void)co_node_send(node, CO_ROUTE_PROCESS, &f);
 	node->emcy.last_tx_us = now_us;
 	node->emcy.sent_any = true;
 	publish(node, &f, true);

@@ -47,7 +47,7 @@ void co_mgr_send_rtr(struct co_mgr_slave *s)
 		.flags = CAN_FRAME_RTR,
 	};
 
-	(void)co_node_send(s->mgr->node, CO_ROUTE_DEFAULT, &f);
+	(void)co_node_send(s->mgr->node, CO_ROUTE_ACTIVE, &f);
 }
 
 void co_mgr_ec_stop(struct co_mgr_slave *s)

@@ -84,7 +84,7 @@ static void nmt_kick(struct co_mgr *m)
 			co_node_timer_start(m->node, &m->nmt_timer, m->nmt_next_us);
 			return;
 		}
-		if (co_node_tx_space(m->node, CO_ROUTE_DEFAULT) <= 0) {
+		if (co_node_tx_space(m->node, CO_ROUTE_ACTIVE) <= 0) {
 			/* Never drop a command: wait for the queue to drain. */
 			co_node_timer_start(m->node, &m->nmt_timer, now + MS_US(1));
 			return;
@@ -93,7 +93,7 @@ static void nmt_kick(struct co_mgr *m)
 		m->nmt_count--;
 		f.data[0] = cmd.cs;
 		f.data[1] = cmd.id;
-		(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+		(void)co_node_send(node, CO_ROUTE_ACTIVE, &f);
 		m->nmt_next_us = now + inhibit_us;
 		nmt_expect(m, cmd.cs, cmd.id);
 		nmt_reset_sent(m, cmd.cs, cmd.id, now);

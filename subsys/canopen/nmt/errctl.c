@@ -47,7 +47,8 @@ static uint64_t now_of(struct co_node *node)
 	return co_node_time(node);
 }
 
-static void send_state(struct co_node *node, uint8_t toggle)
+/* The node's state on @p route: heartbeats on every line it has, guarding answers where asked. */
+static void send_state(struct co_node *node, uint8_t toggle, co_route_t route)
 {
 	struct can_frame f = {
 		.id = CO_NMT_EC_COB_ID + node->node_id,
@@ -55,7 +56,7 @@ static void send_state(struct co_node *node, uint8_t toggle)
 		.data = {(uint8_t)(toggle | (uint8_t)co_node_nmt_state(node))},
 	};
 
-	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+	(void)co_node_send(node, route, &f);
 }
 
 /*
@@ -86,7 +87,10 @@ static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
 	uint64_t period = (uint64_t)node->ec.hb_period_ms * 1000U;
 	uint64_t next = timer->deadline + period;
 
-	send_state(node, 0U);
+	/* Held (redundancy: TPDO supervision) the heartbeat stays silent, its cadence runs on. */
+	if (!node->ec.hb_held) {
+		send_state(node, 0U, CO_ROUTE_PROCESS);
+	}
 	/* Keep the cadence; after a long stall start afresh rather than burst. */
 	if (co_time_before_eq(next, now_us)) {
 		next = now_us + period;
@@ -100,8 +104,8 @@ static void hb_restart(struct co_node *node, bool send_now)
 	if (node->ec.hb_period_ms == 0U || co_node_nmt_state(node) == CO_NMT_INITIALISING) {
 		return;
 	}
-	if (send_now) {
-		send_state(node, 0U);
+	if (send_now && !node->ec.hb_held) {
+		send_state(node, 0U, CO_ROUTE_PROCESS);
 	}
 	co_node_timer_start(node, &node->ec.hb_timer,
 			    now_of(node) + (uint64_t)node->ec.hb_period_ms * 1000U);
@@ -290,7 +294,7 @@ static void guard_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t n
 	    co_node_nmt_state(node) == CO_NMT_INITIALISING) {
 		return;
 	}
-	send_state(node, node->ec.toggle);
+	send_state(node, node->ec.toggle, co_node_route_of(node, rx));
 	node->ec.toggle ^= 0x80U;
 	/* Life guarding starts with the first request. */
 	node->ec.guarded = true;
@@ -448,4 +452,11 @@ int co_hb_get_remote_state(struct co_node *node, uint8_t remote_id, enum co_nmt_
 	}
 	co_node_unlock(node);
 	return err;
+}
+
+void co_hb_hold(struct co_node *node, bool hold)
+{
+	co_node_lock(node);
+	node->ec.hb_held = hold;
+	co_node_unlock(node);
 }

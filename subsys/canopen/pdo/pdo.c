@@ -270,6 +270,45 @@ static void rpdo_mpdo(struct co_rpdo *r, const struct can_frame *frame)
 #endif
 }
 
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+/*
+ * A node on two lines hears a PDO on both: the copy of the frame last taken that comes on the
+ * other line within the window is dropped. Frames on the same line are never dropped (a
+ * value may repeat), and after a line is lost the other line's frames are taken as they come.
+ */
+static bool rpdo_duplicate(struct co_rpdo *r, const struct can_frame *frame, uint64_t now_us)
+{
+	uint8_t line = co_node_rx_line(r->node);
+	uint64_t age = now_us >= r->last_at ? now_us - r->last_at : r->last_at - now_us;
+
+	if (line != r->last_line && frame->dlc == r->last_dlc &&
+	    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
+	    memcmp(frame->data, r->last_data, frame->dlc) == 0) {
+		r->node->pdo.rx_duplicates++;
+		return true;
+	}
+	r->last_at = now_us;
+	r->last_line = line;
+	r->last_dlc = frame->dlc;
+	memcpy(r->last_data, frame->data, frame->dlc);
+	return false;
+}
+#endif
+
+uint32_t co_pdo_rx_duplicates(struct co_node *node)
+{
+	uint32_t n = 0U;
+
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	co_node_lock(node);
+	n = node->pdo.rx_duplicates;
+	co_node_unlock(node);
+#else
+	ARG_UNUSED(node);
+#endif
+	return n;
+}
+
 static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
 {
 	struct co_rpdo *r = rx->user_data;
@@ -281,6 +320,11 @@ static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	if ((frame->flags & CAN_FRAME_RTR) != 0U || !pdo->operational || !cob_valid(r->cob_id)) {
 		return;
 	}
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	if (rpdo_duplicate(r, frame, now_us)) {
+		return;
+	}
+#endif
 	if (frame->dlc < mapped) {
 		rpdo_error(r, ERR_SHORT, true);
 		return;
@@ -377,7 +421,14 @@ static void tpdo_transmit(struct co_tpdo *t, uint64_t now)
 	};
 
 	memcpy(f.data, t->buf, sizeof(t->buf));
-	(void)co_node_send(t->node, CO_ROUTE_DEFAULT, &f);
+	int err = co_node_send(t->node, CO_ROUTE_PROCESS, &f);
+
+	/* Redundancy supervises TPDO 1's sends (CiA 302-6); nobody listening costs one test. */
+	if ((t->node->listen_mask & CO_EV_BIT(CO_EV_TPDO)) != 0U) {
+		struct co_event ev = {.type = CO_EV_TPDO, .tpdo = {.num = t->num, .err = err}};
+
+		(void)co_node_publish(t->node, &ev, NULL);
+	}
 	t->deferred = false;
 	t->inhibit_end = now + t->inhibit_us;
 	if (is_event_type(t->type)) {

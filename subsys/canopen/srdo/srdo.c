@@ -401,9 +401,9 @@ static int send_pair(struct co_node *node, struct co_srdo_inst *in, uint64_t now
 {
 	struct can_frame f[2];
 
-	if (!pack(node, in, f) || co_node_tx_space(node, CO_ROUTE_DEFAULT) < 2 ||
-	    co_node_send(node, CO_ROUTE_DEFAULT, &f[0]) != 0 ||
-	    co_node_send(node, CO_ROUTE_DEFAULT, &f[1]) != 0) {
+	if (!pack(node, in, f) || co_node_tx_space(node, CO_ROUTE_PROCESS) < 2 ||
+	    co_node_send(node, CO_ROUTE_PROCESS, &f[0]) != 0 ||
+	    co_node_send(node, CO_ROUTE_PROCESS, &f[1]) != 0) {
 		fail(in, CO_SRDO_R_TX_FAIL, now_us);
 		return -ENOSPC;
 	}
@@ -957,7 +957,7 @@ int co_srdo_gfc_req(struct co_node *node)
 	} else if (st != CO_NMT_PRE_OPERATIONAL && st != CO_NMT_OPERATIONAL) {
 		ret = -ENETDOWN;
 	} else {
-		ret = co_node_send(node, CO_ROUTE_DEFAULT, &f);
+		ret = co_node_send(node, CO_ROUTE_PROCESS, &f);
 	}
 	co_node_unlock(node);
 	return ret;

@@ -80,7 +80,7 @@ static void send_sync(struct co_node *node, uint64_t now_us)
 		f.data[0] = counter;
 		s->counter = counter >= s->overflow ? 1U : (uint8_t)(counter + 1U);
 	}
-	(void)co_node_send(node, CO_ROUTE_DEFAULT, &f);
+	(void)co_node_send(node, CO_ROUTE_PROCESS, &f);
 	indicate(node, counter, now_us);
 }
 
@@ -120,6 +120,10 @@ static void sync_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	struct co_sync *s = &node->sync;
 	uint8_t want = s->overflow != 0U ? 1U : 0U;
 
+	/* A node on two lines hears SYNC/TIME on both and acts on the active line's. */
+	if (co_node_rx_line(node) != co_node_active_line(node)) {
+		return;
+	}
 	if (!s->enabled || (frame->flags & CAN_FRAME_RTR) != 0U) {
 		return;
 	}

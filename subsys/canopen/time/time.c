@@ -186,6 +186,10 @@ static void time_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 	struct co_time_svc *ts = &node->time;
 	struct co_time t;
 
+	/* A node on two lines hears SYNC/TIME on both and acts on the active line's. */
+	if (co_node_rx_line(node) != co_node_active_line(node)) {
+		return;
+	}
 	if (!ts->enabled) {
 		return;
 	}
@@ -343,7 +347,7 @@ int co_time_req(struct co_node *node, const struct co_time *t)
 	}
 	f.id = ts->cob_id & 0x7ffU;
 	co_time_encode(t, f.data);
-	err = co_node_send(node, CO_ROUTE_DEFAULT, &f);
+	err = co_node_send(node, CO_ROUTE_PROCESS, &f);
 out:
 	co_node_unlock(node);
 	return err;
