@@ -6,8 +6,8 @@
 /*
  * LSS slave (CiA 305), driven frame by frame on a simulation line (no thread, simulated
  * time). Requests go in on 7E5h; every frame the nodes send lands in `sim.sent`. The tests
- * named test_NN_ follow the frame-level behaviours 22..39 of the LSS reference; the others
- * cover the error paths and the decisions of doc/lss.md.
+ * named test_NN_ check the numbered frame-level behaviours of doc/lss.md ("Behaviours and
+ * their tests"); the others cover the error paths and the decisions listed there.
  *
  * The simulation line has no CAN controller, so the tests give the slave a bit rate handler
  * that plays one: it takes 20 kbit/s to 1 Mbit/s, and "stopping" it makes the line's sink
