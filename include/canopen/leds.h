@@ -83,6 +83,8 @@ struct co_leds {
 	struct co_timer timer;
 	struct co_leds_cfg cfg;
 	bool attached;
+	/* The node's LSS slave is in configuration state (RUN flickers). */
+	bool lss_config;
 	/* What the ERR LED shows, from the node's events. */
 	bool bus_off;
 	bool warning;

@@ -116,6 +116,10 @@ static void tick(struct co_timer *timer, uint64_t now_us)
 
 static uint8_t run_pattern(const struct co_node *node)
 {
+	/* LSS configuration (CiA 305) is shown over the NMT state. */
+	if (node->leds.lss_config) {
+		return CO_LED_FLICKER;
+	}
 	switch (co_node_nmt_state(node)) {
 	case CO_NMT_OPERATIONAL:
 		return CO_LED_ON;
@@ -211,6 +215,10 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 				     ev->line.arg == CAN_STATE_ERROR_PASSIVE;
 		}
 		break;
+	case CO_EV_LSS:
+		/* enum co_lss_state: 0 waiting, 1 configuration. */
+		l->lss_config = ev->lss.to != 0U;
+		break;
 	case CO_EV_NMT_RESET:
 		/* A reset drops the stack's own errors; the controller's state stays. */
 		memset(l->hb_lost, 0, sizeof(l->hb_lost));
@@ -236,7 +244,7 @@ static int leds_init(struct co_node *node)
 			 CO_EV_BIT(CO_EV_NMT_STATE) | CO_EV_BIT(CO_EV_NMT_RESET) |
 				 CO_EV_BIT(CO_EV_HB) | CO_EV_BIT(CO_EV_LIFE) |
 				 CO_EV_BIT(CO_EV_ERROR) | CO_EV_BIT(CO_EV_EMCY) |
-				 CO_EV_BIT(CO_EV_LINE),
+				 CO_EV_BIT(CO_EV_LINE) | CO_EV_BIT(CO_EV_LSS),
 			 node_event, NULL);
 	l->run = run_pattern(node);
 	l->err = err_pattern(node);

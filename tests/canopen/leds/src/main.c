@@ -229,6 +229,39 @@ ZTEST(co_leds, test_43_unconfigured_red_flickers_green_off)
 	expect_steady(tr.green, tr.n, false, "green");
 }
 
+static void lss_switch_global(uint8_t mode)
+{
+	const uint8_t f[8] = {0x04, mode};
+
+	co_sim_rx(0x7E5, 8, f);
+}
+
+ZTEST(co_leds, test_43_lss_configuration_green_flickers_in_antiphase_with_red)
+{
+	boot(CO_NODE_ID_UNCONFIGURED, false);
+	lss_switch_global(1);
+	sample(&tr, 1000);
+	expect_cycle(tr.green, tr.n, flicker, 2, 5, "green");
+	expect_cycle(tr.red, tr.n, flicker, 2, 5, "red");
+	for (int i = 0; i < tr.n; i++) {
+		zassert_false(tr.green[i] && tr.red[i], "antiphase at sample %d", i);
+	}
+	lss_switch_global(0);
+	sample(&tr, 500);
+	expect_steady(tr.green, tr.n, false, "green back to Initialising");
+}
+
+ZTEST(co_leds, test_lss_configuration_of_a_configured_node_over_its_nmt_state)
+{
+	lss_switch_global(1);
+	sample(&tr, 1000);
+	expect_cycle(tr.green, tr.n, flicker, 2, 5, "green");
+	expect_steady(tr.red, tr.n, false, "red");
+	lss_switch_global(0);
+	sample(&tr, 2000);
+	expect_cycle(tr.green, tr.n, blink, 2, 3, "green: Pre-operational again");
+}
+
 /* --- ERR LED (44, 45) ----------------------------------------------------------------------- */
 
 ZTEST(co_leds, test_44_heartbeat_timeout_double_flash_cleared_when_heartbeats_return)
