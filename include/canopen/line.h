@@ -557,6 +557,9 @@ uint64_t co_line_now(void);
  */
 uint64_t co_line_time(const struct co_line *line);
 
+/** @brief The line's CAN device, or NULL for a simulation line. */
+const struct device *co_line_device(const struct co_line *line);
+
 /** @} */
 
 /**

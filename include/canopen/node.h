@@ -197,6 +197,16 @@ struct co_od *co_node_od(struct co_node *node);
 /** @brief The node's current node-ID (CO_NODE_ID_UNCONFIGURED while it has none). */
 uint8_t co_node_id(const struct co_node *node);
 
+/**
+ * @brief The node-ID the next Reset Communication puts in force (co_node_set_pending_id()).
+ *
+ * Equal to co_node_id() unless a new one is pending. Requires the node's mutex.
+ */
+static inline uint8_t co_node_pending_id(const struct co_node *node)
+{
+	return node->pending_node_id;
+}
+
 /** @brief The node's default line. */
 struct co_line *co_node_line(struct co_node *node);
 

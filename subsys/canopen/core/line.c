@@ -38,6 +38,11 @@ uint64_t co_line_time(const struct co_line *line)
 	return line->dev == NULL ? line->sim_now : co_line_now();
 }
 
+const struct device *co_line_device(const struct co_line *line)
+{
+	return line->dev;
+}
+
 static void line_init_common(struct co_line *line, const char *name)
 {
 	memset(line, 0, sizeof(*line));

@@ -68,16 +68,10 @@ static bool legacy_100k(void)
 
 /* --- The node, as LSS sees it ------------------------------------------------------------- */
 
-/* The node-ID the next reset puts in force. The core has no getter for it (doc/lss.md). */
-static uint8_t pending_id(const struct co_node *node)
-{
-	return node->pending_node_id;
-}
-
 /* No node-ID now and none to come: what identify non-configured and fastscan look for. */
 static bool unconfigured(const struct co_node *node)
 {
-	return !co_node_is_configured(node) && pending_id(node) == CO_NODE_ID_UNCONFIGURED;
+	return !co_node_is_configured(node) && co_node_pending_id(node) == CO_NODE_ID_UNCONFIGURED;
 }
 
 /* One part of the LSS address: 0 vendor-ID, 1 product code, 2 revision, 3 serial number. */
@@ -86,12 +80,10 @@ static uint32_t address_part(struct co_node *node, uint8_t part)
 	return co_od_uint(co_node_od(node), IDX_IDENTITY, (uint8_t)(part + 1U), 0U);
 }
 
-/* The default line's CAN device; NULL for a simulation line. The line keeps it private and
- * has no getter (doc/lss.md).
- */
+/* The default line's CAN device; NULL for a simulation line. */
 static const struct device *line_device(struct co_node *node)
 {
-	return co_node_line(node)->dev;
+	return co_line_device(co_node_line(node));
 }
 
 static const char *state_str(uint8_t state)
@@ -325,7 +317,7 @@ static uint8_t store(struct co_node *node)
 	}
 	sys_put_le32(REC_MAGIC, &rec[0]);
 	sys_put_le32(l->store_seq + 1U, &rec[4]);
-	rec[8] = pending_id(node);
+	rec[8] = co_node_pending_id(node);
 	rec[9] = CO_LSS_BIT_TIMING_TABLE_CIA;
 	rec[10] = l->bt_index;
 	sys_put_le16(rec_crc(rec), &rec[12]);
@@ -361,11 +353,11 @@ static void switch_global(struct co_node *node, uint8_t mode)
 	 * configured node waits for an NMT reset.
 	 */
 	boot = l->state == CO_LSS_STATE_CONFIGURATION && !co_node_is_configured(node) &&
-	       pending_id(node) != CO_NODE_ID_UNCONFIGURED;
+	       co_node_pending_id(node) != CO_NODE_ID_UNCONFIGURED;
 	set_state(node, CO_LSS_STATE_WAITING);
 	if (boot) {
 		LOG_INF("%s: LSS: node-ID %u, resetting communication", node->name,
-			pending_id(node));
+			co_node_pending_id(node));
 		(void)co_nmt_req(node, CO_NMT_CS_RESET_COMMUNICATION);
 	}
 }
