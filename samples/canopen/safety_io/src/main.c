@@ -313,6 +313,7 @@ struct app_event {
 	uint8_t srdo;
 	uint8_t reason;
 	bool safe;
+	int srdo_state; /* enum co_srdo_state when the event was raised */
 	uint64_t time_us;
 	uint64_t op_us;
 	uint64_t last_pair_us;
@@ -340,6 +341,9 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 		e.srdo = ev->srdo.srdo;
 		e.reason = ev->srdo.reason;
 		e.safe = ev->srdo.safe;
+		/* The event does not tell a deleted SRDO (direction 0) from a valid one. */
+		e.srdo_state = ev->srdo.srdo != 0U ? co_srdo_get_state(node, ev->srdo.srdo, NULL)
+						   : -EINVAL;
 		e.time_us = ev->srdo.time_us;
 	}
 	e.op_us = u->op_us;
@@ -451,6 +455,9 @@ static void print_event(const struct app_event *e)
 	}
 	if (e->srdo == 0U) {
 		printk("%s: GFC received\n", e->unit->name);
+	} else if (!e->safe && e->srdo_state == CO_SRDO_STATE_DELETED) {
+		printk("%s: SRDO %u DELETED (direction 0): no safety data\n", e->unit->name,
+		       e->srdo);
 	} else if (!e->safe) {
 		printk("%s: SRDO %u VALID (first pair %s %s ms after Operational)\n", e->unit->name,
 		       e->srdo, e->unit == &controller ? "received" : "sent",
@@ -508,20 +515,30 @@ static void controller_step(void)
 	struct co_od *od = co_node_od(&controller.node);
 	uint8_t a = 1U;
 	uint8_t b = 0U;
+	int state;
 	bool valid;
 	bool released;
+	const char *why;
 
 	co_node_lock(&controller.node);
-	valid = co_srdo_may_leave_safe_state(&controller.node);
+	/*
+	 * co_srdo_may_leave_safe_state() alone is also true when no SRDO exists: an SDO write of
+	 * 0 to 1301h sub 1 would then release the output with no safety data at all. The output
+	 * needs SRDO 1 itself to be valid too.
+	 */
+	state = co_srdo_get_state(&controller.node, SRDO_NO, NULL);
+	valid = co_srdo_may_leave_safe_state(&controller.node) && state == CO_SRDO_STATE_VALID;
 	(void)co_od_get_u8(od, IDX_CHAN_A, 1, &a);
 	(void)co_od_get_u8(od, IDX_CHAN_B, 1, &b);
 	released = a == 0U && b == 0xFFU;
 	if ((valid && released) != output) {
 		output = valid && released;
 		(void)co_od_set_u8(od, IDX_OUTPUT, 0, output ? 1U : 0U, CO_OD_WRITER_APP);
-		printk("controller: output %s\n", output   ? "ON"
-						  : !valid ? "OFF (SRDO in the safe state)"
-							   : "OFF (emergency stop pressed)");
+		why = output                           ? ""
+		      : state == CO_SRDO_STATE_DELETED ? " (SRDO 1 deleted)"
+		      : !valid                         ? " (SRDO in the safe state)"
+						       : " (emergency stop pressed)";
+		printk("controller: output %s%s\n", output ? "ON" : "OFF", why);
 	}
 	co_node_unlock(&controller.node);
 }
@@ -660,7 +677,7 @@ static void campaign_event(const struct app_event *e)
 	if (e->unit != &controller || e->type != CO_EV_SRDO || e->srdo != SRDO_NO) {
 		return;
 	}
-	run.valid = !e->safe;
+	run.valid = !e->safe && e->srdo_state == CO_SRDO_STATE_VALID;
 	if (run.valid && run.phase == P_WAIT_VALID) {
 		next_fault(now);
 	} else if (e->safe && is_fault(e->reason) && run.phase != P_WAIT_RECOVER &&
