@@ -85,6 +85,28 @@ def test_signature_over_sdo(rig):
     rig.recover()
 
 
+def test_deleted_srdo_keeps_the_output_off(rig):
+    """Direction 0 written over SDO deletes the SRDO: the node may then leave its safe state
+    as far as co_srdo_may_leave_safe_state() goes, but the controller's output needs SRDO 1
+    itself valid, so it stays off although good pairs keep coming."""
+    rig.pre_operational()
+    rig.node.sdo[0x1301][1].raw = 0
+    assert rig.node.sdo[0x13FE].raw == 0x00
+    mark = rig.controller.mark()
+    rig.node.nmt.send_command(0x01)
+    rig.controller.wait_line(r"controller: SRDO 1 DELETED", mark)
+    rig.controller.wait_line(r"controller: node 1 OPERATIONAL", mark)
+    time.sleep(0.5)
+    assert not [line for line in rig.controller.lines_since(mark) if "output ON" in line]
+    assert rig.node.sdo[0x2000].raw == 0, "the output stays off"
+    # Back: direction 2 again, the signature in 13FFh:1 still matches, A5h is accepted.
+    rig.pre_operational()
+    rig.node.sdo[0x1301][1].raw = 2
+    assert rig.node.sdo[0x13FF][1].raw == signature(**rig.srdo_params())
+    rig.node.sdo[0x13FE].raw = 0xA5
+    rig.recover()
+
+
 @pytest.mark.parametrize("case,action,reason,bound_ms", CASES, ids=[c[0] for c in CASES])
 def test_fault_puts_the_controller_in_the_safe_state(wide, case, action, reason, bound_ms):
     rig = wide
