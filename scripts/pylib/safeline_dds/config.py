@@ -1,0 +1,96 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The DDS configuration of the client: the project's loopback configuration, or the user's.
+
+Every SafeLine participant runs on the loopback configuration
+(subsys/canopen/bridge/dds/config/loopback.xml: only `lo`, multicast off). The client refuses to
+start without it, unless the user passes a configuration of their own (--dds-config), which is
+then used as given. CYCLONEDDS_URI is never used: the configuration is always passed to the
+domain explicitly, and Cyclone then ignores the variable.
+"""
+
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+BASE = Path(__file__).resolve().parents[3]
+LOOPBACK = BASE / "subsys" / "canopen" / "bridge" / "dds" / "config" / "loopback.xml"
+DEFAULT_DOMAIN = 42
+NS = "{https://cdds.io/config}"
+
+
+class ConfigError(Exception):
+    """The client cannot start with this configuration."""
+
+
+def loopback_problems(xml_text):
+    """Why a configuration is not the loopback one (empty list: it is)."""
+    try:
+        root = ET.fromstring(xml_text)
+    except ET.ParseError as e:
+        return [f"not XML ({e})"]
+    problems = []
+    domains = root.findall(f"{NS}Domain")
+    if not domains or any(d.get("Id") != "any" for d in domains):
+        problems.append('settings must apply to every domain (<Domain Id="any">)')
+    ifaces = root.findall(f".//{NS}Interfaces/{NS}NetworkInterface")
+    names = [i.get("name") for i in ifaces]
+    if names != ["lo"]:
+        problems.append(f"interfaces {names or 'not pinned'}: must be exactly lo")
+    if any(i.get("multicast", "default") not in ("false",) for i in ifaces):
+        problems.append("multicast must be off on lo")
+    allow = root.find(f".//{NS}General/{NS}AllowMulticast")
+    if allow is None or allow.text.strip() != "false":
+        problems.append("AllowMulticast must be false")
+    peers = [p.get("address") for p in root.findall(f".//{NS}Peers/{NS}Peer")]
+    if any(p not in ("127.0.0.1", "localhost") for p in peers):
+        problems.append(f"peers {peers}: only 127.0.0.1")
+    return problems
+
+
+def load(dds_config=None):
+    """(XML text, description) of the configuration to use.
+
+    dds_config: None for the loopback configuration, else the user's file (or XML text).
+    """
+    if dds_config:
+        if dds_config.lstrip().startswith("<"):
+            return dds_config, "the configuration given"
+        path = Path(dds_config[7:] if dds_config.startswith("file://") else dds_config)
+        try:
+            return path.read_text(), str(path)
+        except OSError as e:
+            raise ConfigError(f"cannot read the DDS configuration {path}: {e.strerror}")
+    try:
+        text = LOOPBACK.read_text()
+    except OSError:
+        raise ConfigError(
+            f"refusing to start: the loopback DDS configuration {LOOPBACK} is missing "
+            "(pass --dds-config FILE to run on a configuration of your own)")
+    problems = loopback_problems(text)
+    if problems:
+        raise ConfigError(f"refusing to start: {LOOPBACK} is not a loopback configuration: "
+                          + "; ".join(problems))
+    return text, "loopback configuration"
+
+
+_domains = {}
+
+
+def domain(domain_id, xml_text):
+    """The process's domain object for domain_id, created once with the configuration."""
+    from cyclonedds.domain import Domain
+
+    d = _domains.get(domain_id)
+    if d is None:
+        d = (Domain(domain_id, xml_text), xml_text)
+        _domains[domain_id] = d
+    elif d[1] != xml_text:
+        raise ConfigError(f"domain {domain_id} already runs with another configuration")
+    return d[0]
+
+
+def client_id(name=None):
+    """`name@host:pid`; the bridge's allow-list matches the name."""
+    if not name:
+        name = os.environ.get("SAFELINE_DDS_CLIENT") or os.environ.get("USER") or "client"
+    return f"{name}@{os.uname().nodename}:{os.getpid()}"[:64]
