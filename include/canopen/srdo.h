@@ -166,12 +166,14 @@ struct co_srdo_inst {
 	/* Timing [µs]: refresh (producer) or SCT (consumer), and SRVT. */
 	uint32_t cycle_us;
 	uint32_t srvt_us;
-	/* Consumer: deadlines of the current pair and of the next valid pair. */
+	/* Consumer: when it started, deadlines of the current pair and of the next valid pair. */
+	uint64_t start_us;
 	uint64_t srvt_deadline;
 	uint64_t sct_deadline;
 	uint16_t cob1;
 	uint16_t cob2;
-	/* Normal entries first, then the inverted ones. */
+	/* In mapping order: even positions normal objects, odd positions their inverted partners.
+	 */
 	struct co_srdo_ent ent[16];
 	uint8_t n_ent;
 	uint8_t len; /* bytes per frame */
@@ -199,10 +201,13 @@ struct co_srdo {
 /**
  * @brief Whether the application may leave its safe state.
  *
- * True when every SRDO that exists (direction 1 or 2) is valid: the node is Operational with
- * a valid configuration, every producer has sent and every consumer has received a valid pair
- * in time, and none has failed since the node entered Operational. SRDOs of direction 0 do
- * not count; with none at all, nothing holds the node in the safe state.
+ * True when the node is Operational, its SRDO configuration is declared valid (13FEh = A5h,
+ * checked when written and on entering Operational) and every SRDO that exists (direction 1
+ * or 2) is valid: every producer has sent and every consumer has received a valid pair in
+ * time, and none has failed since the node entered Operational. SRDOs of direction 0 do not
+ * count, but deleting one over SDO withdraws 13FEh and so makes this false until the
+ * configuration is declared valid again. An application that needs a particular SRDO also
+ * checks it with co_srdo_get_state().
  */
 bool co_srdo_may_leave_safe_state(struct co_node *node);
 

@@ -428,6 +428,11 @@ static void producer_timer(struct co_timer *timer, uint64_t now_us)
 
 /* --- Consumer ------------------------------------------------------------------------------- */
 
+/*
+ * The timer runs at the earlier deadline plus the hand-over allowance: a frame that arrived by
+ * the deadline but still sits in the driver is then judged by its timestamp, not called
+ * missing (CONFIG_CANOPEN_SRDO_RX_ALLOWANCE_US).
+ */
 static void consumer_arm(struct co_srdo_inst *in)
 {
 	uint64_t at = in->sct_deadline;
@@ -435,7 +440,7 @@ static void consumer_arm(struct co_srdo_inst *in)
 	if (in->expect_inverted && co_time_before_eq(in->srvt_deadline, at)) {
 		at = in->srvt_deadline;
 	}
-	co_node_timer_start(in->node, &in->timer, at);
+	co_node_timer_start(in->node, &in->timer, at + CONFIG_CANOPEN_SRDO_RX_ALLOWANCE_US);
 }
 
 static void consumer_timer(struct co_timer *timer, uint64_t now_us)
@@ -461,9 +466,13 @@ static void rx_normal(struct co_rx *rx, const struct can_frame *frame, uint64_t 
 {
 	struct co_srdo_inst *in = rx->user_data;
 
-	/* A second normal frame while the inverted one is due is not a new pair (SRVT runs). */
+	/*
+	 * A second normal frame while the inverted one is due is not a new pair (SRVT runs); a
+	 * frame received before the consumer started belongs to no pair of this run.
+	 */
 	if (!running_consumer(in) || in->expect_inverted ||
-	    (frame->flags & (CAN_FRAME_RTR | CAN_FRAME_IDE)) != 0U) {
+	    (frame->flags & (CAN_FRAME_RTR | CAN_FRAME_IDE)) != 0U ||
+	    !co_time_before_eq(in->start_us, now_us)) {
 		return;
 	}
 	if (frame->dlc < in->len) {
@@ -537,8 +546,9 @@ static void srdo_start(struct co_node *node, struct co_srdo_inst *in, bool valid
 
 	in->dir = (uint8_t)co_od_uint(&node->od, comm_idx(n), SUB_DIR, CO_SRDO_DIR_NONE);
 	if (in->dir == CO_SRDO_DIR_NONE || in->dir > CO_SRDO_DIR_RX) {
+		/* A deleted SRDO holds nobody in the safe state and reports nothing. */
 		in->dir = CO_SRDO_DIR_NONE;
-		set_reason(in, CO_SRDO_R_NONE, now);
+		in->reason = CO_SRDO_R_NONE;
 		return;
 	}
 	if (!valid) {
@@ -566,6 +576,7 @@ static void srdo_start(struct co_node *node, struct co_srdo_inst *in, bool valid
 				    now + (uint64_t)co_node_id(node) *
 						    CONFIG_CANOPEN_SRDO_START_STAGGER_US);
 	} else {
+		in->start_us = now;
 		in->sct_deadline = now + in->cycle_us;
 		consumer_arm(in);
 	}
@@ -884,9 +895,14 @@ const struct co_service co_service_srdo = {
 
 bool co_srdo_may_leave_safe_state(struct co_node *node)
 {
-	bool ok = true;
+	bool ok;
 
 	co_node_lock(node);
+	/*
+	 * Operational with a configuration declared valid (and so checked on the way in): an
+	 * SRDO deleted over SDO withdraws 13FEh, so it cannot release the outputs by its absence.
+	 */
+	ok = co_node_nmt_state(node) == CO_NMT_OPERATIONAL && config_declared_valid(node);
 	for (uint8_t i = 0; i < node->srdo.n_srdo; i++) {
 		const struct co_srdo_inst *in = &node->srdo.inst[i];
 

@@ -654,6 +654,20 @@ ZTEST(co_srdo, test_frames_are_judged_by_their_receive_time)
 	zassert_equal(last_event(2)->time_us, 71 * MS);
 }
 
+ZTEST(co_srdo, test_frames_received_before_the_start_are_ignored)
+{
+	struct can_frame n = {.id = 0x101, .dlc = 1, .data = {0x12}};
+	struct can_frame i = {.id = 0x102, .dlc = 1, .data = {0xED}};
+
+	co_sim_run_until(20 * MS);
+	start_consumer();
+	/* A pair stamped before Operational, handed over after it: not a pair of this run. */
+	co_line_rx(&sim.line, &n, 19 * MS);
+	co_line_rx(&sim.line, &i, 20 * MS);
+	zassert_equal(reason_of(2), CO_SRDO_R_STARTING);
+	zassert_equal(rd(0x6210, 1), 0x00);
+}
+
 /* --- NMT, GFC, restore (19, 20, 21) --------------------------------------------------------- */
 
 ZTEST(co_srdo, test_19_leaving_operational_stops_both_directions)
@@ -719,6 +733,30 @@ ZTEST(co_srdo, test_21_restore_defaults_drops_the_configuration)
 	co_sim_run_until(100 * MS);
 	zassert_equal(count_id(0x109), 0, "no SRDO without a valid configuration");
 	zassert_equal(reason_of(1), CO_SRDO_R_CONFIG);
+}
+
+ZTEST(co_srdo, test_safe_state_needs_operational_and_a_declared_configuration)
+{
+	start_consumer();
+	co_sim_run_until(10 * MS); /* the producer's first pair */
+	rx_pair(0x12);
+	zassert_true(co_srdo_may_leave_safe_state(&t.node));
+	co_sim_nmt(CO_NMT_CS_ENTER_PRE_OPERATIONAL, NODE_ID);
+	zassert_false(co_srdo_may_leave_safe_state(&t.node), "not Operational");
+	/* Deleting every SRDO over SDO withdraws 13FEh: nothing left does not mean safe. */
+	zassert_equal(wr(0x1301, 1, 0, 1), 0U);
+	zassert_equal(wr(0x1302, 1, 0, 1), 0U);
+	int n = t.n_ev;
+
+	start();
+	zassert_equal(t.n_ev, n, "deleted SRDOs report nothing");
+	zassert_equal(co_srdo_get_state(&t.node, 2, NULL), CO_SRDO_STATE_DELETED);
+	zassert_false(co_srdo_may_leave_safe_state(&t.node), "13FEh withdrawn");
+	/* Declared valid with no SRDO: nothing to supervise. */
+	co_sim_nmt(CO_NMT_CS_ENTER_PRE_OPERATIONAL, NODE_ID);
+	zassert_equal(wr(0x13FE, 0, CO_SRDO_VALID, 1), 0U);
+	start();
+	zassert_true(co_srdo_may_leave_safe_state(&t.node));
 }
 
 ZTEST(co_srdo, test_indication_reports_each_transition)
