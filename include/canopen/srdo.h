@@ -142,7 +142,9 @@ enum co_srdo_reason {
  * @param srdo SRDO number 1..64, or 0 for a GFC.
  * @param safe The SRDO is now in the safe state.
  * @param reason Why (enum co_srdo_reason).
- * @param time_us When the fault was detected or the SRDO became valid [µs, node time].
+ * @param time_us When [µs, node time]: for a faulty or valid frame its receive time; for a
+ *        missing frame (SRVT, SCT) when the line thread ran the deadline, i.e. the deadline
+ *        plus the thread's wake-up (and CONFIG_CANOPEN_SRDO_RX_ALLOWANCE_US).
  * @param user_data As registered.
  */
 typedef void (*co_srdo_ind_t)(struct co_node *node, uint8_t srdo, bool safe,
