@@ -89,8 +89,16 @@ def domain(domain_id, xml_text):
     return d[0]
 
 
+_clients = []
+
+
 def client_id(name=None):
-    """`name@host:pid`; the bridge's allow-list matches the name."""
+    """`name@host:pid` (`.n` for the n-th client of a process); the allow-list matches the
+    name. Requests and replies are keyed by it, so no two clients share one."""
     if not name:
         name = os.environ.get("SAFELINE_DDS_CLIENT") or os.environ.get("USER") or "client"
-    return f"{name}@{os.uname().nodename}:{os.getpid()}"[:64]
+    _clients.append(name)
+    n = len(_clients)
+    suffix = f".{n}" if n > 1 else ""
+    host = os.uname().nodename[:24]
+    return f"{name[:32]}@{host}:{os.getpid()}{suffix}"[:64]

@@ -13,7 +13,6 @@ configuration only, and the namespace checks are skipped with the reason.
 import ctypes
 import os
 import subprocess
-from pathlib import Path
 
 CLONE_NEWUSER = 0x10000000
 CLONE_NEWNET = 0x40000000
@@ -86,20 +85,27 @@ def isolated():
     return _state["isolated"], _state["reason"]
 
 
+def _net_dev():
+    """{interface: (tx_packets, rx_packets)} of this process's network namespace.
+
+    /proc/net/dev follows the namespace of the reader (/sys/class/net would show the one
+    sysfs was mounted in)."""
+    out = {}
+    with open("/proc/net/dev") as f:
+        for line in f.readlines()[2:]:
+            name, data = line.split(":", 1)
+            fields = data.split()
+            out[name.strip()] = (int(fields[9]), int(fields[1]))
+    return out
+
+
 def interfaces():
-    return sorted(p.name for p in Path("/sys/class/net").iterdir())
+    return sorted(_net_dev())
 
 
 def leak_counters():
     """{interface: (tx_packets, rx_packets)} of every interface but lo."""
-    out = {}
-    for name in interfaces():
-        if name == "lo":
-            continue
-        base = Path("/sys/class/net") / name / "statistics"
-        out[name] = (int((base / "tx_packets").read_text()),
-                     int((base / "rx_packets").read_text()))
-    return out
+    return {k: v for k, v in _net_dev().items() if k != "lo"}
 
 
 def check_no_leak(before, after):

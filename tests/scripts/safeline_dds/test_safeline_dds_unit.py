@@ -225,8 +225,11 @@ def test_without_the_loopback_configuration_the_client_refuses(tmp_path, monkeyp
 def test_client_id_carries_the_name_the_allow_list_matches(monkeypatch):
     monkeypatch.setenv("SAFELINE_DDS_CLIENT", "ops")
     cid = config.client_id()
-    assert cid.startswith("ops@") and cid.endswith(f":{os.getpid()}")
+    assert cid.startswith("ops@") and re.search(rf":{os.getpid()}(\.\d+)?$", cid)
+    again = config.client_id("ops")
+    assert again.startswith("ops@") and again != cid, "two clients never share an id"
     assert config.client_id("admin").startswith("admin@")
+    assert len(config.client_id("x" * 100)) <= 64
 
 
 # --- commands on canned data ---------------------------------------------------------------------

@@ -682,10 +682,26 @@ static void snapshot(struct br_bnode *b, int slot, uint64_t t_ns)
 	}
 }
 
+/* The controller's state and error counters now (not for a simulation line). */
+static void read_can_state(struct br_line *l)
+{
+	enum can_state cs;
+	struct can_bus_err_cnt cnt = {0};
+
+	if (l->line->dev != NULL && can_get_state(l->line->dev, &cs, &cnt) == 0 &&
+	    (l->can_state != (uint8_t)cs || l->tec != cnt.tx_err_cnt || l->rec != cnt.rx_err_cnt)) {
+		l->can_state = (uint8_t)cs;
+		l->tec = cnt.tx_err_cnt;
+		l->rec = cnt.rx_err_cnt;
+		l->dirty = true;
+	}
+}
+
 static void apply_line_event(struct br_line *l, const struct br_event *e)
 {
 	if (e->line.event == CO_LINE_EV_CAN_STATE) {
 		l->can_state = (uint8_t)e->line.arg;
+		read_can_state(l);
 	}
 	l->dirty = true;
 }
@@ -828,19 +844,7 @@ static void refresh(void)
 		struct co_line_stats st;
 
 		co_line_get_stats(l->line, &st);
-		if (l->line->dev != NULL) {
-			enum can_state cs;
-			struct can_bus_err_cnt cnt = {0};
-
-			if (can_get_state(l->line->dev, &cs, &cnt) == 0 &&
-			    (l->can_state != (uint8_t)cs || l->tec != cnt.tx_err_cnt ||
-			     l->rec != cnt.rx_err_cnt)) {
-				l->can_state = (uint8_t)cs;
-				l->tec = cnt.tx_err_cnt;
-				l->rec = cnt.rx_err_cnt;
-				l->dirty = true;
-			}
-		}
+		read_can_state(l);
 		if (memcmp(&st, &l->stats, sizeof(st)) != 0) {
 			l->stats = st;
 			l->dirty = true;
@@ -855,6 +859,10 @@ static void refresh(void)
 static void publish_dirty(void)
 {
 	int n_lines = (int)atomic_get(&br.n_lines);
+
+	if (atomic_cas(&br.bridge_dirty, 1, 0)) {
+		publish_bridge();
+	}
 
 	for (int slot = 0; slot < n_lines; slot++) {
 		struct br_line *l = &br.lines[slot];
@@ -929,6 +937,9 @@ static dds_qos_t *qos_state(int depth)
 	dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
 	dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
 	dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+	/* What a late joiner gets: as much as the history (the default would be 1 sample). */
+	dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, depth, DDS_LENGTH_UNLIMITED,
+				    DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
 	/* "Bridge gone" is NOT_ALIVE_NO_WRITERS, not DISPOSED. */
 	dds_qset_writer_data_lifecycle(q, false);
 	return q;
@@ -1132,6 +1143,8 @@ int co_bridge_dds_add_line(struct co_line *line, uint8_t line_no, const char *na
 	l->line_no = line_no;
 	l->can_state = 0xFFU;
 	l->dirty = true;
+	read_can_state(l);
+	co_line_get_stats(line, &l->stats);
 	if (name != NULL) {
 		strcpy(l->name, name);
 	}
@@ -1143,7 +1156,11 @@ int co_bridge_dds_add_line(struct co_line *line, uint8_t line_no, const char *na
 	};
 	err = co_rx_register(line, &l->hb_rx);
 	if (err == 0) {
+		struct br_event wake = {.kind = BR_EV_WAKE, .slot = 0xFFU};
+
 		atomic_set(&br.n_lines, n + 1);
+		atomic_set(&br.bridge_dirty, 1);
+		(void)k_msgq_put(&br_queue, &wake, K_NO_WAIT);
 	}
 	k_mutex_unlock(&br.lock);
 	return err;
@@ -1204,6 +1221,7 @@ int co_bridge_dds_add_node(struct co_node *node, const struct co_bridge_dds_node
 		br.lines[b->slot[CO_LINE_DEFAULT]].nodes++;
 		br.lines[b->slot[CO_LINE_DEFAULT]].dirty = true;
 		atomic_set(&br.n_bnodes, n + 1);
+		atomic_set(&br.bridge_dirty, 1);
 		e.slot = b->slot[CO_LINE_DEFAULT];
 		e.node_id = b->node_id;
 		e.src = b->idx;

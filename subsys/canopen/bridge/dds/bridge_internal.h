@@ -254,6 +254,8 @@ struct br_state {
 	atomic_t malformed;
 	atomic_t replies_deferred;
 	atomic_t replies_lost;
+	/* Lines or nodes were added: canopen/bridge_state is written again at once. */
+	atomic_t bridge_dirty;
 	atomic_t bridge_done;
 	atomic_t req_done;
 };
