@@ -20,6 +20,9 @@
  * Output: a boot table when the NMT startup finishes, then one line per NMT or heartbeat
  * event. Events reach the main thread through a message queue, so nothing is printed from a
  * line thread with a node lock held.
+ *
+ * --dds starts the Cyclone DDS bridge (doc/dds-bridge.md) on the manager's line: a second
+ * terminal watches the network with scripts/safeline-dds watch.
  */
 
 #include <errno.h>
@@ -31,6 +34,7 @@
 #include <zephyr/logging/log.h>
 
 #include <can_virtual.h>
+#include <canopen/bridge_dds.h>
 #include <canopen/cfg.h>
 #include <canopen/line.h>
 #include <canopen/mgr.h>
@@ -56,6 +60,10 @@ LOG_MODULE_REGISTER(manager, LOG_LEVEL_INF);
 static unsigned int slaves_arg = MAX_SLAVES;
 static unsigned int cycle_arg = 4U;
 static unsigned int cut_arg = 3U;
+static bool dds_arg;
+static char *dds_config_arg;
+static char *dds_allow_arg;
+static uint32_t dds_domain_arg = CO_BRIDGE_DDS_DOMAIN_DEFAULT;
 
 static void slaves_found(char *argv, int offset)
 {
@@ -70,6 +78,16 @@ static void cycle_found(char *argv, int offset)
 static void cut_found(char *argv, int offset)
 {
 	cut_arg = (unsigned int)cmd_read_uint_option("cut", &argv[offset], 0U, 127U);
+}
+
+static void dds_found(char *argv, int offset)
+{
+	dds_arg = true;
+}
+
+static void dds_domain_found(char *argv, int offset)
+{
+	dds_domain_arg = (uint32_t)cmd_read_uint_option("dds-domain", &argv[offset], 0U, 232U);
 }
 
 static void add_options(void)
@@ -98,6 +116,39 @@ static void add_options(void)
 			.call_when_found = cut_found,
 			.descript = "cut this in-process slave off the virtual bus 2 s after the "
 				    "startup, for 1 s (default 3, 0 = none)",
+		},
+		{
+			.is_switch = true,
+			.option = "dds",
+			.type = 'b',
+			.call_when_found = dds_found,
+			.descript = "start the DDS bridge on the manager's line (loopback only; "
+				    "watch it with scripts/safeline-dds watch)",
+		},
+		{
+			.option = "dds-domain",
+			.name = "0..232",
+			.type = 'u',
+			.call_when_found = dds_domain_found,
+			.descript = "DDS domain of the bridge (default 42)",
+		},
+		{
+			.option = "dds-config",
+			.name = "file",
+			.type = 's',
+			.dest = &dds_config_arg,
+			.descript =
+				"Cyclone DDS configuration of the bridge instead of its loopback "
+				"one (a deliberate choice: it may leave the host)",
+		},
+		{
+			.option = "dds-allow",
+			.name = "file|none",
+			.type = 's',
+			.dest = &dds_allow_arg,
+			.descript =
+				"the bridge's allow-list (default dds/allow.conf of the sample; "
+				"none: read-only)",
 		},
 		ARG_TABLE_ENDMARKER,
 	};
@@ -453,6 +504,152 @@ static void demo(enum demo_action a, unsigned int cycle, unsigned int cut, uint6
 	}
 }
 
+/* --- DDS bridge (--dds) --------------------------------------------------------------------- */
+
+/*
+ * The SDO client of the manager that serves the bridge's requests: the first above the slave
+ * slots (1F25h requests take the highest idle client first, so they use client 9).
+ */
+#define DDS_SDO_CLIENT CONFIG_CANOPEN_MGR_SLAVES
+#define DATA_INDEX     0x2100U
+#define DATA_CAPACITY  (128U * 1024U)
+
+/*
+ * With --dds the in-process slaves serve hello_node's 2100h data buffer (DOMAIN, up to
+ * 128 KiB) as the hello_node sample does, so that large SDO transfers can go through the
+ * bridge. Chunks stream into a shadow that becomes the value when the last one arrived.
+ */
+struct data_buf {
+	uint8_t value[DATA_CAPACITY];
+	uint8_t shadow[DATA_CAPACITY];
+	uint32_t len;
+	uint32_t shadow_len;
+};
+
+static struct data_buf data_bufs[MAX_SLAVES];
+
+static uint32_t data_info(const struct co_od_provider *p, struct co_od_info *info)
+{
+	if (info->sub != 0U) {
+		return CO_SDO_AB_NO_SUB;
+	}
+	info->dtype = CO_DTYPE_DOMAIN;
+	info->access = CO_OD_ACCESS_RW;
+	info->flags = CO_OD_F_STREAM;
+	info->objcode = CO_OD_OBJ_VAR;
+	info->size = DATA_CAPACITY;
+	return 0;
+}
+
+static uint32_t data_length(const struct co_od_provider *p, const struct co_od_info *info)
+{
+	return ((struct data_buf *)p->user_data)->len;
+}
+
+static uint32_t data_read(const struct co_od_provider *p, const struct co_od_info *info,
+			  uint32_t offset, void *buf, size_t cap, size_t *len)
+{
+	struct data_buf *d = p->user_data;
+	size_t n = 0;
+
+	if (offset < d->len) {
+		n = MIN(cap, (size_t)(d->len - offset));
+		memcpy(buf, &d->value[offset], n);
+	}
+	*len = n;
+	return 0;
+}
+
+static uint32_t data_write(const struct co_od_provider *p, const struct co_od_info *info,
+			   uint32_t offset, const void *data, size_t len, bool last)
+{
+	struct data_buf *d = p->user_data;
+
+	if (data == NULL) {
+		d->shadow_len = 0U;
+		return 0;
+	}
+	if (offset == 0U) {
+		d->shadow_len = 0U;
+	}
+	if (offset != d->shadow_len || len > DATA_CAPACITY - offset) {
+		return CO_SDO_AB_DATA_LONG;
+	}
+	memcpy(&d->shadow[offset], data, len);
+	d->shadow_len = offset + (uint32_t)len;
+	if (last) {
+		memcpy(d->value, d->shadow, d->shadow_len);
+		d->len = d->shadow_len;
+	}
+	return 0;
+}
+
+static const struct co_od_provider_api data_api = {
+	.info = data_info,
+	.length = data_length,
+	.read = data_read,
+	.write = data_write,
+};
+
+static struct co_od_provider data_providers[MAX_SLAVES];
+
+#if defined(CONFIG_CANOPEN_BRIDGE_DDS)
+/* The bridge: started before the nodes, so it sees the whole boot. */
+static int dds_start(void)
+{
+	const char *allow = MANAGER_DDS_DIR "/allow.conf";
+	struct co_bridge_dds_config cfg = {
+		.name = "manager",
+		.domain_id = dds_domain_arg,
+		.dds_config = dds_config_arg,
+		.config_file = MANAGER_DDS_DIR "/bridge.conf",
+	};
+	int err;
+
+	if (dds_allow_arg != NULL) {
+		allow = strcmp(dds_allow_arg, "none") == 0 ? NULL : dds_allow_arg;
+	}
+	cfg.allow_file = allow;
+	err = co_bridge_dds_init(&cfg);
+	if (err != 0) {
+		LOG_ERR("DDS bridge failed to start (%d)", err);
+	}
+	return err;
+}
+
+/* The manager's line and the manager; the slaves are seen through the manager. */
+static int dds_attach(void)
+{
+	struct co_bridge_dds_node_config ncfg = {.name = "manager", .sdo_client = DDS_SDO_CLIENT};
+	int err = co_bridge_dds_add_line(&mline, 0U, "line0");
+
+	if (err == 0) {
+		err = co_bridge_dds_add_node(&mgr, &ncfg);
+	}
+	if (err != 0) {
+		LOG_ERR("DDS bridge: cannot follow the manager (%d)", err);
+	}
+	return err;
+}
+
+static void dds_stop(void)
+{
+	co_bridge_dds_stop();
+}
+NATIVE_TASK(dds_stop, ON_EXIT, 10);
+#else
+static int dds_start(void)
+{
+	LOG_ERR("--dds: built without CONFIG_CANOPEN_BRIDGE_DDS");
+	return -ENOTSUP;
+}
+
+static int dds_attach(void)
+{
+	return -ENOTSUP;
+}
+#endif
+
 /* --- Set-up -------------------------------------------------------------------------------- */
 
 static int start_slave(unsigned int i)
@@ -471,6 +668,15 @@ static int start_slave(unsigned int i)
 	if (err == 0) {
 		err = co_node_init(&s->node, node_names[i], &s->line, &hello_node_od_def, &s->ram,
 				   (uint8_t)(FIRST_SLAVE + i));
+	}
+	if (err == 0 && dds_arg) {
+		data_providers[i] = (struct co_od_provider){
+			.api = &data_api,
+			.index_first = DATA_INDEX,
+			.index_last = DATA_INDEX,
+			.user_data = &data_bufs[i],
+		};
+		err = co_od_provider_register(co_node_od(&s->node), &data_providers[i]);
 	}
 	if (err == 0) {
 		err = co_line_start(&s->line, slave_stacks[i],
@@ -511,6 +717,9 @@ static int start_manager(uint8_t id)
 	co_mgr_set_ec_ind(&mgr, on_ec, NULL);
 	co_hb_set_ind(&mgr, on_hb, NULL);
 	co_nmt_set_state_ind(&mgr, on_own_state, NULL);
+	if (dds_arg && dds_attach() != 0) {
+		return -EIO;
+	}
 	err = co_line_start(&mline, mline_stack, K_THREAD_STACK_SIZEOF(mline_stack),
 			    CONFIG_CANOPEN_LINE_THREAD_PRIORITY);
 	if (err == 0) {
@@ -542,6 +751,9 @@ int main(void)
 		cut = 0U; /* only an in-process slave on the virtual bus can be cut */
 	}
 
+	if (dds_arg && dds_start() != 0) {
+		return 1;
+	}
 	/* Slaves first, so they are on the bus when the manager resets them. */
 	for (unsigned int i = 0; i < n_slaves; i++) {
 		err = start_slave(i);
