@@ -44,7 +44,6 @@
 #include "posix_native_task.h"
 #include "rdn_master_od.h"
 #include "rdn_slave_od.h"
-#include "sample_common.h"
 
 #define N_UNITS     4
 #define N_SLAVES    (N_UNITS - 1)
@@ -319,8 +318,11 @@ static int unit_start(struct unit *u, int index)
 	int err = 0;
 
 	for (int l = 0; l < (int)CO_NODE_LINES && err == 0; l++) {
+		char dev_name[16];
+
 		/* Controller 2i is on bus 0 (default line), 2i + 1 on bus 1 (redundant line). */
-		u->can[l] = sample_line_device(2U * index + l);
+		(void)snprintf(dev_name, sizeof(dev_name), "can_virtual%d", 2 * index + l);
+		u->can[l] = device_get_binding(dev_name);
 		err = u->can[l] == NULL
 			      ? -ENODEV
 			      : co_line_init(&u->line[l], line_names[index][l], u->can[l]);
