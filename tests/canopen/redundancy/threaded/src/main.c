@@ -56,8 +56,12 @@
 #define HB_MS       50U
 #define CONSUMER_MS 125U
 #define PDO_MS      10U
-/* What the threads may be late by on a loaded machine (and much more under TSan). */
-#define ALLOW_MS    (IS_ENABLED(CONFIG_TSAN) ? 400U : 100U)
+/*
+ * What the threads may be late by on a loaded machine, and much more under TSan (seen: a
+ * switch 600 ms after the start of a flood, with two cores shared with other builds; 100 ms
+ * when the machine is quiet).
+ */
+#define ALLOW_MS    (IS_ENABLED(CONFIG_TSAN) ? 1000U : 200U)
 /* The earliest a cut can be noticed: the last heartbeat came at most a period before it. */
 #define EARLIEST_MS (CONSUMER_MS - HB_MS)
 #define BOUND_MS    (CONSUMER_MS + HB_MS)
