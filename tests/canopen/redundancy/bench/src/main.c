@@ -22,7 +22,9 @@
  *   switch_event   cut -> the application's CO_EV_REDUNDANCY SWITCH listener ran
  *   active_frame   cut -> the first probe of the node on the redundant line (what goes on the
  *                  active line moved; resolution 2 ms)
- *   any_frame      cut -> the first frame of any kind of the node on the redundant line
+ *   any_frame      cut -> the first frame of any kind of the node on the redundant line (its
+ *                  EMCY 8120h, as its controller on the cut line turns error passive, or a
+ *                  heartbeat or PDO: those go on both lines all the time)
  *   network        cut -> the last node's SWITCH (the network is on the new line)
  *   switch_back    restore -> the SWITCH back (doc: after three heartbeat cycles, 100-150 ms)
  *
@@ -407,8 +409,8 @@ int main(void)
 	snprintf(extra, sizeof(extra), ", \"cuts\": %u, \"probe_every_ms\": %d", cuts_arg,
 		 PROBE_MS);
 	figure("redundancy.first_active_frame", s_active, n_active, BOUND_MS, extra);
-	snprintf(extra, sizeof(extra), ", \"cuts\": %u, \"what\": \"heartbeat, PDO or probe\"",
-		 cuts_arg);
+	snprintf(extra, sizeof(extra),
+		 ", \"cuts\": %u, \"what\": \"EMCY, heartbeat, PDO or probe\"", cuts_arg);
 	figure("redundancy.first_frame_new_line", s_any, n_any, 0U, extra);
 	snprintf(extra, sizeof(extra),
 		 ", \"cuts\": %u, \"expected_ms\": \"%u-%u (three heartbeat cycles)\"", cuts_arg,
