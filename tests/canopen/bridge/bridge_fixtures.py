@@ -128,6 +128,9 @@ def firmware(tmp_path, domain):
     for fw in started:
         if fw.proc.poll() is None:
             fw.stop()
+    for fw in started:
+        bad = re.search(r"^.*(Sanitizer|runtime error:|SAFELINE FATAL ERROR).*$", fw.text(), re.M)
+        assert bad is None, f"{fw.log_path}: {bad.group(0)}"
 
 
 @pytest.fixture

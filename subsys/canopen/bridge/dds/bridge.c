@@ -1075,7 +1075,9 @@ int co_bridge_dds_init(const struct co_bridge_dds_config *cfg)
 	if (!atomic_cas(&started, 0, 1)) {
 		return -EALREADY;
 	}
-	memset(&br, 0, sizeof(br));
+	/* br is zero from the start and initialised once (started): no memset, which a thread
+	 * stopping the bridge at exit could see half done.
+	 */
 	k_mutex_init(&br.lock);
 	strcpy(br.name, name);
 	br.domain_id = cfg->domain_id == CO_BRIDGE_DDS_DOMAIN_DEFAULT
@@ -1095,6 +1097,7 @@ int co_bridge_dds_init(const struct co_bridge_dds_config *cfg)
 	}
 	if (err != 0) {
 		br_conf_free(&br.conf);
+		memset(&br.conf, 0, sizeof(br.conf));
 		atomic_set(&started, 0);
 		return err;
 	}
