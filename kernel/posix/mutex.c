@@ -78,7 +78,8 @@ static bool try_take(struct k_mutex *mutex, struct k_thread *cur)
 	return false;
 }
 
-static int lock_slow(struct k_mutex *mutex, struct k_thread *cur, k_timeout_t timeout)
+static __attribute__((noinline)) int lock_slow(struct k_mutex *mutex, struct k_thread *cur,
+					       k_timeout_t timeout)
 {
 	struct k_thread *owner;
 	struct k_thread *waiter;
@@ -137,22 +138,42 @@ static int lock_slow(struct k_mutex *mutex, struct k_thread *cur, k_timeout_t ti
 	return -EAGAIN;
 }
 
-int k_mutex_lock(struct k_mutex *mutex, k_timeout_t timeout)
+/* A host thread the kernel has not met yet takes its thread object first (rare). */
+static __attribute__((noinline)) int lock_adopt(struct k_mutex *mutex, k_timeout_t timeout)
 {
-	struct k_thread *cur = z_current();
+	struct k_thread *cur = z_current_adopt();
 
-	if (__atomic_load_n(&mutex->owner, __ATOMIC_RELAXED) == cur) {
-		mutex->lock_count++;
-		return 0;
-	}
 	if (try_take(mutex, cur)) {
 		return 0;
 	}
 	return lock_slow(mutex, cur, timeout);
 }
 
+/*
+ * The fast paths below are leaf code (the waits are out of line), so a free mutex costs one
+ * compare-and-swap and a handful of loads and stores, as a futex does.
+ */
+int k_mutex_lock(struct k_mutex *mutex, k_timeout_t timeout)
+{
+	struct k_thread *cur = z_current_thread;
+
+	if (unlikely(cur == NULL)) {
+		return lock_adopt(mutex, timeout);
+	}
+	if (likely(try_take(mutex, cur))) {
+		return 0;
+	}
+	/* Held: by this thread (a recursive lock), or a wait. */
+	if (__atomic_load_n(&mutex->owner, __ATOMIC_RELAXED) == cur) {
+		mutex->lock_count++;
+		return 0;
+	}
+	return lock_slow(mutex, cur, timeout);
+}
+
 /* Hand the mutex to the first waiter, or free it; drop a boost. Kernel lock held. */
-static void unlock_slow(struct k_mutex *mutex, struct k_thread *cur, int orig_prio)
+static __attribute__((noinline)) void unlock_slow(struct k_mutex *mutex, struct k_thread *cur,
+						  int orig_prio)
 {
 	struct k_thread *new_owner;
 
@@ -176,16 +197,14 @@ static void unlock_slow(struct k_mutex *mutex, struct k_thread *cur, int orig_pr
 
 int k_mutex_unlock(struct k_mutex *mutex)
 {
-	struct k_thread *cur = z_current();
+	/* A thread without a thread object (NULL) owns no mutex: -EINVAL or -EPERM below. */
+	struct k_thread *cur = z_current_thread;
 	struct k_thread *owner = __atomic_load_n(&mutex->owner, __ATOMIC_RELAXED);
 	int orig_prio;
 	int expected = M_LOCKED;
 
-	if (owner == NULL) {
-		return -EINVAL;
-	}
-	if (owner != cur) {
-		return -EPERM;
+	if (unlikely(owner != cur || owner == NULL)) {
+		return owner == NULL ? -EINVAL : -EPERM;
 	}
 	if (mutex->lock_count > 1U) {
 		mutex->lock_count--;
@@ -196,9 +215,9 @@ int k_mutex_unlock(struct k_mutex *mutex)
 	orig_prio = __atomic_load_n(&mutex->owner_orig_prio, __ATOMIC_RELAXED);
 	mutex->lock_count = 0U;
 	__atomic_store_n(&mutex->owner, NULL, __ATOMIC_RELAXED);
-	if (prio_of(cur) == orig_prio &&
-	    __atomic_compare_exchange_n(&mutex->state, &expected, M_FREE, false, __ATOMIC_RELEASE,
-					__ATOMIC_RELAXED)) {
+	if (likely(prio_of(cur) == orig_prio &&
+		   __atomic_compare_exchange_n(&mutex->state, &expected, M_FREE, false,
+					       __ATOMIC_RELEASE, __ATOMIC_RELAXED))) {
 		return 0;
 	}
 	unlock_slow(mutex, cur, orig_prio);
