@@ -72,6 +72,10 @@ typedef void (*co_timer_handler_t)(struct co_timer *timer, uint64_t now_us);
 /**
  * @brief Send a frame in simulation mode (no CAN device).
  *
+ * Runs in the sending thread (or the one draining the TX queue). As a CAN driver's
+ * can_send(), it may be called by several threads at once when several threads send: a frame
+ * goes to it without the line's TX lock while nothing waits in the TX queue.
+ *
  * @retval 0 The frame was taken.
  * @retval -EAGAIN The sink is full; the line queues the frame and retries on co_line_process().
  */
@@ -149,6 +153,11 @@ struct co_rx {
 	/** @cond INTERNAL_HIDDEN */
 	struct co_rx *next;
 	struct co_line *line;
+	/* The line's copy of (id, ext) and mask, for masked and 29-bit receivers: written when
+	 * the receiver joins a line, read by lookups that take no lock (line.c).
+	 */
+	uint32_t key_id;
+	uint32_t key_mask;
 	/** @endcond */
 };
 
@@ -220,10 +229,16 @@ struct co_line {
 	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
 	/* 29-bit and masked receivers, searched in order. */
 	struct co_rx *others;
+	/*
+	 * Sequence count of the receive table: odd while a writer (holding lock) changes it.
+	 * Lookups read the table without the lock and keep their result only when the count
+	 * was even and unchanged around the read (line.c, "Receive table").
+	 */
+	uint32_t rx_seq;
 	/* Armed timers sorted by deadline. */
 	sys_slist_t timers;
-	/* Protects the receive table and the timer list. Leaf lock: never held while a node
-	 * lock is taken.
+	/* Serialises changes of the receive table, protects the timer list. Leaf lock: never
+	 * held while a node lock is taken.
 	 */
 	struct k_mutex lock;
 
@@ -445,7 +460,10 @@ bool co_timer_is_armed(const struct co_timer *timer);
  * @brief Send a frame on the line, in order with every frame sent before.
  *
  * When the driver reports back-pressure the frame waits in the line's TX queue and goes out as
- * soon as the driver takes frames again; the caller never retries.
+ * soon as the driver takes frames again; the caller never retries. While the queue is empty
+ * the frame goes straight to the driver without the line's TX lock. "Before" is the order of
+ * the calls: a send that returned before another began goes out first; sends that overlap in
+ * time, from different threads, may go out in either order.
  *
  * @retval 0 Sent or queued.
  * @retval -ENOBUFS The TX queue is full; the frame is dropped, counted and reported
@@ -523,7 +541,9 @@ struct co_line *co_line_current(void);
 /**
  * @brief Dispatch one received frame to its receivers.
  *
- * The line thread calls this for each frame; simulation tests call it directly.
+ * The line thread calls this for each frame; simulation tests call it directly, from one
+ * thread at a time. The receivers are looked up without a lock (receivers may be registered
+ * and moved meanwhile by any thread); each is called with its own lock held.
  *
  * @param line Line.
  * @param frame Received frame.

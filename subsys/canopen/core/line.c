@@ -7,13 +7,16 @@
  * The I/O-free core of a line: receive table, timers, TX queue. The threaded binding is in
  * line_thread.c; everything here also runs on simulated time from a unit test.
  *
- * Locking: line->lock protects the receive table and the timer list and is a leaf lock. A
- * handler is looked up under line->lock, which is released before the owner's lock is taken,
+ * Locking: line->lock serialises changes of the receive table, protects the timer list and
+ * is a leaf lock. Receivers are looked up without it (a sequence count, see "Receive table"),
+ * so a received frame takes one lock: its receiver's (the node's mutex). A timer handler is
+ * taken off the list under line->lock, which is released before the owner's lock is taken,
  * so a node lock is never acquired while line->lock is held (no lock-order inversion with an
  * application thread that holds its node lock and arms a timer).
  */
 
 #include <errno.h>
+#include <limits.h>
 #include <string.h>
 
 #include <zephyr/kernel.h>
@@ -213,9 +216,41 @@ void co_line_listener_remove(struct co_line_listener *l)
 
 /* --- Receive table --------------------------------------------------------------------- */
 
+/*
+ * Lookups take no lock. Changes (register, unregister, move, detach) are made under
+ * line->lock, between two increments of line->rx_seq: odd while a change is under way. A
+ * lookup reads rx_seq, walks the table and reads rx_seq again; it keeps what it found only
+ * when both reads gave the same even count, else it looks again, and at the second miss (or
+ * while a writer is at work) it looks under the lock. Every word a lookup reads (the index,
+ * the slots, the chains, the match keys, rx_seq) is written with a release store and read
+ * with an acquire load: a lookup that sees any part of a change also sees the odd count the
+ * change began with, so it cannot keep a half-made table (no fences needed, TSan sees
+ * every pair). Receivers are never freed (they live in the services), so a lookup that
+ * follows a pointer a writer has just unlinked reads valid memory, and throws the result
+ * away. A walk is bounded, so a lookup racing a stream of changes cannot loop.
+ */
+
+#define KEY_EXT BIT(31)
+
+/* More steps than any sane table needs: a lookup that takes more retries under the lock. */
+#define RX_WALK_MAX 256
+
+#define LD_ACQ(p)    __atomic_load_n((p), __ATOMIC_ACQUIRE)
+#define ST_REL(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
+
 static bool rx_is_direct(const struct co_rx *rx)
 {
 	return !rx->ext && (rx->mask & SFF_MASK) == SFF_MASK;
+}
+
+static void tbl_change_begin(struct co_line *line)
+{
+	__atomic_store_n(&line->rx_seq, line->rx_seq + 1U, __ATOMIC_RELAXED);
+}
+
+static void tbl_change_end(struct co_line *line)
+{
+	ST_REL(&line->rx_seq, line->rx_seq + 1U);
 }
 
 static int slot_find_free(struct co_line *line)
@@ -243,8 +278,10 @@ static inline void rx_line_set(struct co_rx *rx, struct co_line *line)
 	__atomic_store_n(&rx->line, line, __ATOMIC_RELEASE);
 }
 
+/* Link a receiver; table lock held, between tbl_change_begin() and tbl_change_end(). */
 static int rx_link(struct co_line *line, struct co_rx *rx)
 {
+	ST_REL(&rx->next, NULL);
 	if (rx_is_direct(rx)) {
 		uint32_t id = rx->id & SFF_MASK;
 		uint8_t slot = line->sff[id];
@@ -255,9 +292,8 @@ static int rx_link(struct co_line *line, struct co_rx *rx)
 			if (free < 0) {
 				return -ENOSPC;
 			}
-			line->sff[id] = (uint8_t)(free + 1);
-			line->slots[free] = rx;
-			rx->next = NULL;
+			ST_REL(&line->slots[free], rx);
+			ST_REL(&line->sff[id], (uint8_t)(free + 1));
 		} else {
 			/* Append, so receivers of one id see frames in registration order. */
 			struct co_rx *tail = line->slots[slot - 1U];
@@ -265,22 +301,23 @@ static int rx_link(struct co_line *line, struct co_rx *rx)
 			while (tail->next != NULL) {
 				tail = tail->next;
 			}
-			tail->next = rx;
-			rx->next = NULL;
+			ST_REL(&tail->next, rx);
 		}
 	} else {
 		struct co_rx **pp = &line->others;
 
+		ST_REL(&rx->key_id, rx->id | (rx->ext ? KEY_EXT : 0U));
+		ST_REL(&rx->key_mask, rx->mask | KEY_EXT);
 		while (*pp != NULL) {
 			pp = &(*pp)->next;
 		}
-		*pp = rx;
-		rx->next = NULL;
+		ST_REL(pp, rx);
 	}
 	rx_line_set(rx, line);
 	return 0;
 }
 
+/* Unlink a receiver; as rx_link(). */
 static void rx_unlink(struct co_line *line, struct co_rx *rx)
 {
 	struct co_rx **pp;
@@ -297,10 +334,10 @@ static void rx_unlink(struct co_line *line, struct co_rx *rx)
 			pp = &(*pp)->next;
 		}
 		if (*pp == rx) {
-			*pp = rx->next;
+			ST_REL(pp, rx->next);
 		}
 		if (line->slots[slot - 1U] == NULL) {
-			line->sff[id] = 0U;
+			ST_REL(&line->sff[id], 0U);
 		}
 	} else {
 		pp = &line->others;
@@ -308,10 +345,10 @@ static void rx_unlink(struct co_line *line, struct co_rx *rx)
 			pp = &(*pp)->next;
 		}
 		if (*pp == rx) {
-			*pp = rx->next;
+			ST_REL(pp, rx->next);
 		}
 	}
-	rx->next = NULL;
+	ST_REL(&rx->next, NULL);
 	rx_line_set(rx, NULL);
 }
 
@@ -331,7 +368,9 @@ int co_rx_register(struct co_line *line, struct co_rx *rx)
 	if (rx->line != NULL) {
 		err = -EALREADY;
 	} else {
+		tbl_change_begin(line);
 		err = rx_link(line, rx);
+		tbl_change_end(line);
 	}
 	k_mutex_unlock(&line->lock);
 	return err;
@@ -346,7 +385,9 @@ void co_rx_unregister(struct co_rx *rx)
 	}
 	k_mutex_lock(&line->lock, K_FOREVER);
 	if (rx->line == line) {
+		tbl_change_begin(line);
 		rx_unlink(line, rx);
+		tbl_change_end(line);
 	}
 	k_mutex_unlock(&line->lock);
 }
@@ -367,18 +408,15 @@ int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id)
 		co_rx_unregister(rx);
 	}
 	k_mutex_lock(&line->lock, K_FOREVER);
+	tbl_change_begin(line);
 	if (rx->line != NULL) {
 		rx_unlink(line, rx);
 	}
 	rx->id = id;
 	err = rx_link(line, rx);
+	tbl_change_end(line);
 	k_mutex_unlock(&line->lock);
 	return err;
-}
-
-static bool rx_matches(const struct co_rx *rx, const struct can_frame *frame, bool ext)
-{
-	return rx->ext == ext && ((frame->id ^ rx->id) & rx->mask) == 0U;
 }
 
 /*
@@ -391,7 +429,7 @@ static void rx_call(struct co_line *line, struct co_rx *rx, const struct can_fra
 	if (rx->lock != NULL) {
 		k_mutex_lock(rx->lock, K_FOREVER);
 	}
-	/* Collected under the table lock; its owner may have removed it since. */
+	/* Found by a lookup; its owner may have removed it since. */
 	if (rx_line_get(rx) == line) {
 		rx->handler(rx, frame, now_us);
 	}
@@ -400,24 +438,124 @@ static void rx_call(struct co_line *line, struct co_rx *rx, const struct can_fra
 	}
 }
 
-/* Add a receiver to a frame's batch; one beyond CONFIG_CANOPEN_LINE_RX_FANOUT is counted. */
-static inline void batch_add(struct co_line *line, struct co_rx **batch, int *n, struct co_rx *rx)
+/* Whether a receiver takes part: only those of @p lock, or all but those of @p origin. */
+static inline bool rx_selected(const struct co_rx *rx, const struct k_mutex *lock, bool only)
 {
-	if (*n < CONFIG_CANOPEN_LINE_RX_FANOUT) {
-		batch[(*n)++] = rx;
-	} else {
-		if (line->stats.rx_fanout_drops == 0U) {
-			LOG_WRN("%s: a frame matched more than %d receivers; raise "
-				"CONFIG_CANOPEN_LINE_RX_FANOUT",
-				line->name, CONFIG_CANOPEN_LINE_RX_FANOUT);
+	return only ? rx->lock == lock : (lock == NULL || rx->lock != lock);
+}
+
+/*
+ * The receivers of a frame, in table order, into batch (the first
+ * CONFIG_CANOPEN_LINE_RX_FANOUT of them). Returns how many matched, or -1 when the walk took
+ * more than @p budget steps (a lookup racing changes; done again under the lock).
+ */
+static ALWAYS_INLINE int rx_collect(const struct co_line *line, const struct can_frame *frame,
+				    const struct k_mutex *lock, bool only, struct co_rx **batch,
+				    int budget)
+{
+	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
+	struct co_rx *rx;
+	int m = 0;
+
+	if (!ext) {
+		uint8_t slot = LD_ACQ(&line->sff[frame->id & SFF_MASK]);
+
+		for (rx = slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL; rx != NULL;
+		     rx = LD_ACQ(&rx->next)) {
+			if (--budget < 0) {
+				return -1;
+			}
+			if (rx_selected(rx, lock, only)) {
+				if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
+					batch[m] = rx;
+				}
+				m++;
+			}
 		}
-		line->stats.rx_fanout_drops++;
+	}
+	rx = LD_ACQ(&line->others);
+	if (rx != NULL) {
+		uint32_t key = frame->id | (ext ? KEY_EXT : 0U);
+
+		for (; rx != NULL; rx = LD_ACQ(&rx->next)) {
+			if (--budget < 0) {
+				return -1;
+			}
+			if (((key ^ LD_ACQ(&rx->key_id)) & LD_ACQ(&rx->key_mask)) == 0U &&
+			    rx_selected(rx, lock, only)) {
+				if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
+					batch[m] = rx;
+				}
+				m++;
+			}
+		}
+	}
+	return m;
+}
+
+/* The lookup missed a change of the table: once more without the lock, then under it. */
+static __attribute__((noinline)) int rx_collect_again(struct co_line *line,
+						      const struct can_frame *frame,
+						      const struct k_mutex *lock, bool only,
+						      struct co_rx **batch)
+{
+	uint32_t seq = LD_ACQ(&line->rx_seq);
+	int m;
+
+	if ((seq & 1U) == 0U) {
+		m = rx_collect(line, frame, lock, only, batch, RX_WALK_MAX);
+		if (m >= 0 && LD_ACQ(&line->rx_seq) == seq) {
+			return m;
+		}
+	}
+	k_mutex_lock(&line->lock, K_FOREVER);
+	m = rx_collect(line, frame, lock, only, batch, INT_MAX);
+	k_mutex_unlock(&line->lock);
+	return m;
+}
+
+/* Receivers a frame could not reach: more matched than CONFIG_CANOPEN_LINE_RX_FANOUT. */
+static __attribute__((noinline)) void rx_fanout_dropped(struct co_line *line, uint32_t drops)
+{
+	if (__atomic_fetch_add(&line->stats.rx_fanout_drops, drops, __ATOMIC_RELAXED) == 0U) {
+		LOG_WRN("%s: a frame matched more than %d receivers; raise "
+			"CONFIG_CANOPEN_LINE_RX_FANOUT",
+			line->name, CONFIG_CANOPEN_LINE_RX_FANOUT);
 	}
 }
 
+/* A counter only the line's dispatcher writes; read by co_line_get_stats(). */
+static inline void stat_inc(uint32_t *counter)
+{
+	__atomic_store_n(counter, __atomic_load_n(counter, __ATOMIC_RELAXED) + 1U,
+			 __ATOMIC_RELAXED);
+}
+
+/*
+ * A frame from the bus. The common case, one receiver for an 11-bit id and no masked or
+ * 29-bit receivers on the line, is looked up and called here; anything else goes through
+ * co_line_dispatch_sel().
+ */
 int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
 {
-	return co_line_dispatch(line, frame, now_us, NULL);
+	uint32_t seq = LD_ACQ(&line->rx_seq);
+
+	if (likely((frame->flags & CAN_FRAME_IDE) == 0U && (seq & 1U) == 0U)) {
+		uint8_t slot = LD_ACQ(&line->sff[frame->id & SFF_MASK]);
+		struct co_rx *rx = slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL;
+
+		if (rx != NULL && LD_ACQ(&rx->next) == NULL && LD_ACQ(&line->others) == NULL &&
+		    LD_ACQ(&line->rx_seq) == seq) {
+			if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
+				/* Simulation: one thread drives the line. */
+				line->sim_now = now_us;
+			}
+			stat_inc(&line->stats.rx_frames);
+			rx_call(line, rx, frame, now_us);
+			return 1;
+		}
+	}
+	return co_line_dispatch_sel(line, frame, now_us, NULL, false);
 }
 
 int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
@@ -426,44 +564,37 @@ int co_line_dispatch(struct co_line *line, const struct can_frame *frame, uint64
 	return co_line_dispatch_sel(line, frame, now_us, origin, false);
 }
 
+/* Look the receivers up (without the table lock, see above), then call each with its owner's
+ * lock held.
+ */
 int co_line_dispatch_sel(struct co_line *line, const struct can_frame *frame, uint64_t now_us,
 			 const struct k_mutex *lock, bool only)
 {
 	/* only: the receivers of @p lock alone; else every receiver but those of @p lock. */
-	const struct k_mutex *origin = only ? NULL : lock;
-	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
 	struct co_rx *batch[CONFIG_CANOPEN_LINE_RX_FANOUT];
-	int n = 0;
+	uint32_t seq = LD_ACQ(&line->rx_seq);
+	int n = -1;
 
-	/* Collect the receivers under the table lock, call them without it. */
-	k_mutex_lock(&line->lock, K_FOREVER);
 	if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
+		/* Simulation: one thread drives the line. */
 		line->sim_now = now_us;
 	}
-	if (!ext) {
-		uint8_t slot = line->sff[frame->id & SFF_MASK];
-
-		for (struct co_rx *rx = slot != 0U ? line->slots[slot - 1U] : NULL; rx != NULL;
-		     rx = rx->next) {
-			if (only ? rx->lock == lock : (origin == NULL || rx->lock != origin)) {
-				batch_add(line, batch, &n, rx);
-			}
-		}
+	if (likely((seq & 1U) == 0U)) {
+		n = rx_collect(line, frame, lock, only, batch, RX_WALK_MAX);
 	}
-	for (struct co_rx *rx = line->others; rx != NULL; rx = rx->next) {
-		if (rx_matches(rx, frame, ext) &&
-		    (only ? rx->lock == lock : (origin == NULL || rx->lock != origin))) {
-			batch_add(line, batch, &n, rx);
-		}
+	if (unlikely(n < 0 || LD_ACQ(&line->rx_seq) != seq)) {
+		n = rx_collect_again(line, frame, lock, only, batch);
 	}
-	if (origin == NULL && !only) {
-		line->stats.rx_frames++;
+	if (unlikely(n > CONFIG_CANOPEN_LINE_RX_FANOUT)) {
+		rx_fanout_dropped(line, (uint32_t)(n - CONFIG_CANOPEN_LINE_RX_FANOUT));
+		n = CONFIG_CANOPEN_LINE_RX_FANOUT;
+	}
+	if (lock == NULL && !only) {
+		stat_inc(&line->stats.rx_frames);
 		if (n == 0) {
-			line->stats.rx_unhandled++;
+			stat_inc(&line->stats.rx_unhandled);
 		}
 	}
-	k_mutex_unlock(&line->lock);
-
 	for (int i = 0; i < n; i++) {
 		rx_call(line, batch[i], frame, now_us);
 	}
@@ -639,7 +770,7 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 /* --- Transmission ------------------------------------------------------------------------ */
 
 /* Hand one frame to the driver or the sink. Returns 0, -EAGAIN (back-pressure) or an error. */
-static int tx_submit(struct co_line *line, const struct can_frame *frame)
+static inline int tx_submit(struct co_line *line, const struct can_frame *frame)
 {
 	int err;
 
@@ -657,6 +788,18 @@ static int tx_submit(struct co_line *line, const struct can_frame *frame)
 	return err;
 }
 
+/* tx_count changes under the TX lock and is read without it by line_send(). */
+static inline void tx_count_set(struct co_line *line, uint16_t n)
+{
+	__atomic_store_n(&line->tx_count, n, __ATOMIC_RELEASE);
+}
+
+/* Sends that take no lock count here too. */
+static inline void tx_frames_inc(struct co_line *line)
+{
+	(void)__atomic_fetch_add(&line->stats.tx_frames, 1U, __ATOMIC_RELAXED);
+}
+
 static void txq_push(struct co_line *line, const struct can_frame *frame,
 		     const struct k_mutex *origin)
 {
@@ -665,7 +808,7 @@ static void txq_push(struct co_line *line, const struct can_frame *frame,
 
 	line->txq[tail] = *frame;
 	line->txq_origin[tail] = origin;
-	line->tx_count++;
+	tx_count_set(line, line->tx_count + 1U);
 	line->stats.tx_queued++;
 	atomic_set_bit(&line->flags, CO_LINE_F_TX_WAITING);
 	if (line->tx_count > line->stats.tx_queue_max) {
@@ -673,28 +816,31 @@ static void txq_push(struct co_line *line, const struct can_frame *frame,
 	}
 }
 
-static int line_send(struct co_line *line, const struct can_frame *frame,
-		     const struct k_mutex *origin)
+/*
+ * The rest of line_send(), under the TX lock: the driver refused the frame with @p err
+ * (-EAGAIN: it is full, the frame waits in the queue), or (@p err == 1) frames were waiting:
+ * the frame queues behind them, or goes to the driver if they have gone meanwhile.
+ */
+static __attribute__((noinline)) int line_send_slow(struct co_line *line,
+						    const struct can_frame *frame,
+						    const struct k_mutex *origin, int err)
 {
-	int err = 0;
 	bool overflow = false;
 	bool error = false;
 
 	k_mutex_lock(&line->tx_lock, K_FOREVER);
-	if (line->tx_count == 0U) {
-		err = tx_submit(line, frame);
-		if (err == 0) {
-			line->stats.tx_frames++;
-		} else if (err == -EAGAIN) {
-			txq_push(line, frame, origin);
-			err = 0;
-		} else {
-			line->stats.tx_errors++;
-			error = true;
-		}
+	if (err == 1) {
+		err = line->tx_count == 0U ? tx_submit(line, frame) : -EAGAIN;
+	}
+	if (err == 0) {
+		tx_frames_inc(line);
+	} else if (err != -EAGAIN) {
+		line->stats.tx_errors++;
+		error = true;
 	} else if (line->tx_count < CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE) {
-		/* Frames are waiting: queue behind them to keep the order. */
+		/* Frames are waiting or the driver is full: queue to keep the order. */
 		txq_push(line, frame, origin);
+		err = 0;
 	} else {
 		line->stats.tx_dropped++;
 		overflow = true;
@@ -709,6 +855,28 @@ static int line_send(struct co_line *line, const struct can_frame *frame,
 		co_line_report_from_send(line, CO_LINE_EV_TX_ERROR, err);
 	}
 	return err;
+}
+
+/*
+ * While nothing waits in the TX queue a frame goes straight to the driver, without the TX
+ * lock (the driver serialises its own callers). Order is kept: a frame queued before this
+ * send began has made tx_count non-zero (release store under the lock, acquire load here),
+ * so this one queues behind it; a queued frame is drained before tx_count drops to zero.
+ * Only sends that overlap in time may go out in either order, as they would on a bus.
+ */
+static ALWAYS_INLINE int line_send(struct co_line *line, const struct can_frame *frame,
+				   const struct k_mutex *origin)
+{
+	int err = 1;
+
+	if (likely(__atomic_load_n(&line->tx_count, __ATOMIC_ACQUIRE) == 0U)) {
+		err = tx_submit(line, frame);
+		if (likely(err == 0)) {
+			tx_frames_inc(line);
+			return 0;
+		}
+	}
+	return line_send_slow(line, frame, origin, err);
 }
 
 int co_line_send(struct co_line *line, const struct can_frame *frame)
@@ -739,7 +907,7 @@ int co_line_tx_purge(struct co_line *line, const struct k_mutex *origin,
 		}
 		w++;
 	}
-	line->tx_count = w;
+	tx_count_set(line, w);
 	line->stats.tx_purged += (uint32_t)purged;
 	if (line->tx_count == 0U) {
 		atomic_clear_bit(&line->flags, CO_LINE_F_TX_WAITING);
@@ -804,7 +972,9 @@ void co_line_detach(struct co_line *line, struct co_line_member *m)
 	k_mutex_lock(&line->lock, K_FOREVER);
 	for (struct co_line_member **pp = &line->members; *pp != NULL; pp = &(*pp)->next) {
 		if (*pp == m) {
+			tbl_change_begin(line);
 			purge_owner(line, m->lock);
+			tbl_change_end(line);
 			*pp = m->next;
 			m->next = NULL;
 			__atomic_store_n(&line->n_nodes, (uint8_t)(line->n_nodes - 1U),
@@ -829,24 +999,30 @@ bool co_line_owner_held(struct co_line *line)
 	return held;
 }
 
+/* A frame a node sent, for the line's other nodes: through the RX queue to the line thread. */
+static __attribute__((noinline)) void
+local_deliver(struct co_line *line, const struct can_frame *frame, const struct k_mutex *origin)
+{
+	struct co_line_rx_msg msg = {
+		.frame = *frame,
+		.time_us = co_line_time(line),
+		.origin = origin,
+		.kind = CO_LINE_MSG_LOCAL,
+	};
+
+	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
+		atomic_inc(&line->rx_overruns);
+		atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+	}
+}
+
 int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 		      const struct k_mutex *origin)
 {
 	int err = line_send(line, frame, origin);
-	uint8_t n_nodes = __atomic_load_n(&line->n_nodes, __ATOMIC_RELAXED);
 
-	if (err == 0 && n_nodes > 1U) {
-		struct co_line_rx_msg msg = {
-			.frame = *frame,
-			.time_us = co_line_time(line),
-			.origin = origin,
-			.kind = CO_LINE_MSG_LOCAL,
-		};
-
-		if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
-			atomic_inc(&line->rx_overruns);
-			atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
-		}
+	if (err == 0 && __atomic_load_n(&line->n_nodes, __ATOMIC_RELAXED) > 1U) {
+		local_deliver(line, frame, origin);
 	}
 	return err;
 }
@@ -878,13 +1054,13 @@ void co_line_tx_drain(struct co_line *line)
 			break;
 		}
 		if (err == 0) {
-			line->stats.tx_frames++;
+			tx_frames_inc(line);
 		} else {
 			line->stats.tx_errors++;
 		}
 		line->tx_head =
 			(uint16_t)((line->tx_head + 1U) % CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE);
-		line->tx_count--;
+		tx_count_set(line, line->tx_count - 1U);
 		if (err != 0) {
 			break;
 		}
@@ -901,10 +1077,20 @@ void co_line_tx_drain(struct co_line *line)
 
 void co_line_get_stats(struct co_line *line, struct co_line_stats *stats)
 {
-	k_mutex_lock(&line->lock, K_FOREVER);
+	const struct co_line_stats *s = &line->stats;
+
+	memset(stats, 0, sizeof(*stats));
 	k_mutex_lock(&line->tx_lock, K_FOREVER);
-	*stats = line->stats;
-	stats->rx_overruns = (uint32_t)atomic_get(&line->rx_overruns);
+	stats->tx_frames = __atomic_load_n(&s->tx_frames, __ATOMIC_RELAXED);
+	stats->tx_queued = s->tx_queued;
+	stats->tx_dropped = s->tx_dropped;
+	stats->tx_errors = s->tx_errors;
+	stats->tx_queue_max = s->tx_queue_max;
+	stats->tx_purged = s->tx_purged;
 	k_mutex_unlock(&line->tx_lock);
-	k_mutex_unlock(&line->lock);
+	/* Counted by the dispatcher, which takes no lock. */
+	stats->rx_frames = __atomic_load_n(&line->stats.rx_frames, __ATOMIC_RELAXED);
+	stats->rx_unhandled = __atomic_load_n(&line->stats.rx_unhandled, __ATOMIC_RELAXED);
+	stats->rx_fanout_drops = __atomic_load_n(&line->stats.rx_fanout_drops, __ATOMIC_RELAXED);
+	stats->rx_overruns = (uint32_t)atomic_get(&line->rx_overruns);
 }
