@@ -31,6 +31,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include <canopen/sdo_abort.h>
 #include <canopen/types.h>
@@ -563,43 +564,161 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
  * struct co_od_cover beside it: which hooks cover the object and whether its value can be
  * moved directly. It is made at first use and made again whenever the hook table changed
  * (co_od.hook_gen), so a write or read through it behaves exactly as co_od_write_info() /
- * co_od_read_info() (same checks, hooks and abort codes) without scanning the hook table
- * for objects no hook covers.
+ * co_od_read_info() (same checks, hooks and abort codes) without scanning the hook table.
+ *
+ * Both accessors are inline for the common case of a PDO or SRDO moving a plain value (a
+ * fixed-size RAM value whose C storage is its wire format, mappable in that direction, no
+ * limits, no validate or read-check hook, at most one notify hook): a comparison of
+ * generations, a copy and, for a covered object, one call of its notify hook. Everything
+ * else goes to the functions of od.c.
  * @{
  */
 /** @cond INTERNAL_HIDDEN */
-#define CO_OD_COVER_MADE       0x01U /* made for hook_gen == gen */
-#define CO_OD_COVER_VALIDATE   0x02U /* a validate hook covers the object */
-#define CO_OD_COVER_NOTIFY     0x04U /* a notify hook covers the object */
-#define CO_OD_COVER_READ_CHECK 0x08U /* a read-check hook covers the object */
-#define CO_OD_COVER_DIRECT     0x10U /* RAM value of a fixed-size type */
-#define CO_OD_COVER_CHECK      0x20U /* limits or BOOLEAN: check the value */
-#define CO_OD_COVER_COPY       0x40U /* the C storage is the wire format (memcpy) */
+#define CO_OD_COVER_MADE       0x01U   /* made for hook_gen == gen */
+#define CO_OD_COVER_VALIDATE   0x02U   /* a validate hook covers the object */
+#define CO_OD_COVER_NOTIFY     0x04U   /* a notify hook covers the object */
+#define CO_OD_COVER_READ_CHECK 0x08U   /* a read-check hook covers the object */
+#define CO_OD_COVER_DIRECT     0x10U   /* RAM value of a fixed-size type */
+#define CO_OD_COVER_CHECK      0x20U   /* limits or BOOLEAN: check the value */
+#define CO_OD_COVER_COPY       0x40U   /* the C storage is the wire format (memcpy) */
+#define CO_OD_COVER_EXACT      0x80U   /* every hook in [first, end) covers the object */
+#define CO_OD_COVER_MAP_W      0x100U  /* PDO/SRDO writers may write it (RPDO-mappable) */
+#define CO_OD_COVER_MAP_R      0x200U  /* PDO/SRDO readers may read it (TPDO-mappable) */
+#define CO_OD_COVER_NOTIFY1    0x400U  /* exactly one hook covers it, a notify hook */
+#define CO_OD_COVER_W_FAST     0x800U  /* a PDO/SRDO write: copy, then NOTIFY1's hook if set */
+#define CO_OD_COVER_R_FAST     0x1000U /* a PDO/SRDO read: copy */
 /** @endcond */
 
 /** @brief Hook coverage of one object; zero-initialise, then leave to the accessors. */
 struct co_od_cover {
-	uint32_t gen;   /**< co_od.hook_gen when made */
+	uint32_t gen;   /**< co_od.hook_gen when made (never 0: a zeroed cover is stale) */
 	uint16_t first; /**< position of the first hook covering the object */
 	uint16_t end;   /**< one past the last hook covering it */
-	uint8_t flags;  /**< CO_OD_COVER_* */
+	uint16_t flags; /**< CO_OD_COVER_* */
 };
+
+/** @cond INTERNAL_HIDDEN */
+/* The whole of co_od_write_cached() / co_od_read_cached(), out of line. */
+uint32_t co_od_write_cover(struct co_od *od, const struct co_od_info *info,
+			   struct co_od_cover *cover, const void *data, size_t len,
+			   enum co_od_writer writer);
+uint32_t co_od_read_cover(const struct co_od *od, const struct co_od_info *info,
+			  struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
+			  enum co_od_writer reader);
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+/* The lock rule (doc/architecture.md): stops the program when the node's mutex is not held. */
+void co_od_assert_locked(const struct co_od *od);
+#endif
+
+static inline bool co_od_cover_fast_(const struct co_od *od, const struct co_od_info *info,
+				     const struct co_od_cover *cover, uint16_t flag, size_t len,
+				     enum co_od_writer who)
+{
+	return cover->gen == od->hook_gen && (cover->flags & flag) != 0U && len == info->size &&
+	       (who == CO_OD_WRITER_PDO || who == CO_OD_WRITER_SRDO);
+}
+/** @endcond */
+
+/**
+ * @brief Whether a PDO/SRDO write of the whole value through @p cover is, now, a copy of its
+ * wire bytes followed by co_od_cover_notify() (fresh cover, plain value, no check, no
+ * validate hook, at most one notify hook).
+ *
+ * For a mapping that moves several objects per frame (PDO): it may test this once for all
+ * of them, copy, and call co_od_cover_notify() for each; as long as co_od.hook_gen is what it
+ * was, the answer stands.
+ */
+static inline bool co_od_cover_plain_write(const struct co_od *od, const struct co_od_cover *cover)
+{
+	return cover->gen == od->hook_gen && (cover->flags & CO_OD_COVER_W_FAST) != 0U;
+}
+
+/** @brief As co_od_cover_plain_write(), for a PDO/SRDO read: a copy of the value. */
+static inline bool co_od_cover_plain_read(const struct co_od *od, const struct co_od_cover *cover)
+{
+	return cover->gen == od->hook_gen && (cover->flags & CO_OD_COVER_R_FAST) != 0U;
+}
+
+/**
+ * @brief The notify pass of a plain write (co_od_cover_plain_write()) once the bytes are
+ * copied: the one notify hook covering the object, if any.
+ */
+static inline void co_od_cover_notify(struct co_od *od, const struct co_od_info *info,
+				      const struct co_od_cover *cover, const void *data, size_t len,
+				      enum co_od_writer writer)
+{
+	if ((cover->flags & CO_OD_COVER_NOTIFY1) != 0U) {
+		/* The pass of one hook: nothing can follow it (od.c). */
+		const struct co_od_req req = {
+			.info = info, .writer = writer, .data = data, .len = len};
+		const struct co_od_hook *h = &od->hooks[cover->first];
+
+		h->notify(od, &req, h->user_data);
+	}
+}
+
+/**
+ * @brief Copy a value of 1, 2, 4 or 8 bytes with constant lengths (inlined).
+ * @return false, with nothing copied, for another length
+ */
+static inline bool co_od_copy_word(void *dst, const void *src, size_t n)
+{
+	switch (n) {
+	case 1:
+		memcpy(dst, src, 1);
+		return true;
+	case 2:
+		memcpy(dst, src, 2);
+		return true;
+	case 4:
+		memcpy(dst, src, 4);
+		return true;
+	case 8:
+		memcpy(dst, src, 8);
+		return true;
+	default:
+		return false;
+	}
+}
 
 /**
  * @brief co_od_write_info() of a whole value, using (and refreshing) @p cover.
  * @return as co_od_write_info()
  */
-uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
-			    struct co_od_cover *cover, const void *data, size_t len,
-			    enum co_od_writer writer);
+static inline uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
+					  struct co_od_cover *cover, const void *data, size_t len,
+					  enum co_od_writer writer)
+{
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+	co_od_assert_locked(od);
+#endif
+	if (co_od_cover_fast_(od, info, cover, CO_OD_COVER_W_FAST, len, writer) &&
+	    co_od_copy_word(od->ram + info->desc->offset, data, len)) {
+		co_od_cover_notify(od, info, cover, data, len, writer);
+		return 0U;
+	}
+	return co_od_write_cover(od, info, cover, data, len, writer);
+}
 
 /**
  * @brief co_od_read_info() from offset 0, using (and refreshing) @p cover.
  * @return as co_od_read_info()
  */
-uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
-			   struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
-			   enum co_od_writer reader);
+static inline uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
+					 struct co_od_cover *cover, void *buf, size_t cap,
+					 size_t *len, enum co_od_writer reader)
+{
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+	co_od_assert_locked(od);
+#endif
+	if (cap >= info->size &&
+	    co_od_cover_fast_(od, info, cover, CO_OD_COVER_R_FAST, info->size, reader) &&
+	    co_od_copy_word(buf, od->ram + info->desc->offset, info->size)) {
+		*len = info->size;
+		return 0U;
+	}
+	return co_od_read_cover(od, info, cover, buf, cap, len, reader);
+}
 /** @} */
 
 /** @brief co_od_find() then co_od_write_info(). */

@@ -16,6 +16,8 @@
 
 #include "od_internal.h"
 
+#define OD_UNLIKELY(x) __builtin_expect(!!(x), 0)
+
 /* ---------------------------------------------------------------------------------------- */
 /* Data types */
 
@@ -434,6 +436,7 @@ int co_od_init(struct co_od *od, const struct co_od_def *def, void *ram, uint8_t
 	od->def = def;
 	od->ram = ram;
 	od->node_id = node_id;
+	od->hook_gen = 1U;
 	memcpy(od->ram, def->ram_defaults, def->ram_size);
 	apply_nodeid(od, 0x0000, 0xFFFF);
 	return 0;
@@ -488,6 +491,18 @@ void co_od_reset_app(struct co_od *od)
 /* ---------------------------------------------------------------------------------------- */
 /* Hooks and providers */
 
+/*
+ * Every change of the hook table makes the caches of "which hooks cover this object"
+ * (struct co_od_cover) stale. The generation is never 0, so a zeroed cover is stale too.
+ */
+static void hook_gen_bump(struct co_od *od)
+{
+	od->hook_gen++;
+	if (od->hook_gen == 0U) {
+		od->hook_gen = 1U;
+	}
+}
+
 /* Remove every hook registered from registration number @p first on (a failed batch). */
 static void hooks_drop_from(struct co_od *od, uint32_t first)
 {
@@ -508,7 +523,7 @@ static void hooks_drop_from(struct co_od *od, uint32_t first)
 		w++;
 	}
 	od->n_hooks = w;
-	od->hook_gen++;
+	hook_gen_bump(od);
 }
 
 int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n)
@@ -553,7 +568,7 @@ int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 	od->hooks[pos] = *hook;
 	od->hook_seq[pos] = od->hook_next_seq++;
 	od->n_hooks++;
-	od->hook_gen++;
+	hook_gen_bump(od);
 	uint16_t span = hook->index_last - hook->index_first;
 
 	if (span > od->hook_span) {
@@ -585,7 +600,7 @@ int co_od_hook_unregister(struct co_od *od, const void *user_data)
 	}
 	od->n_hooks = w;
 	if (removed > 0) {
-		od->hook_gen++;
+		hook_gen_bump(od);
 	}
 	return removed;
 }
@@ -691,11 +706,12 @@ static uint32_t run_validate(struct co_od *od, const struct co_od_req *req)
 	return run_validate_at(od, req, hooks_start(od, req->info->index), UINT16_MAX);
 }
 
-static void run_notify_at(struct co_od *od, const struct co_od_req *req, uint16_t i, uint16_t end)
+/* The notify pass from position @p i; @p limit: hooks registered from then on do not run. */
+static void notify_from(struct co_od *od, const struct co_od_req *req, uint16_t i, uint16_t end,
+			uint32_t limit)
 {
 	uint16_t index = req->info->index;
 	uint32_t gen = od->hook_gen;
-	uint32_t limit = od->hook_next_seq;
 
 	while (i < od->n_hooks && i < end && od->hooks[i].index_first <= index) {
 		const struct co_od_hook *h = &od->hooks[i];
@@ -717,6 +733,11 @@ static void run_notify_at(struct co_od *od, const struct co_od_req *req, uint16_
 			i++;
 		}
 	}
+}
+
+static void run_notify_at(struct co_od *od, const struct co_od_req *req, uint16_t i, uint16_t end)
+{
+	notify_from(od, req, i, end, od->hook_next_seq);
 }
 
 static void run_notify(struct co_od *od, const struct co_od_req *req)
@@ -1124,16 +1145,33 @@ static inline void copy_fixed(void *dst, const void *src, uint32_t size)
 		memcpy(dst, src, 8);
 		break;
 	default:
-		memcpy(dst, src, size);
+		/* Not a size of a copied type (1, 2, 4, 8); a loop keeps callers leaf code. */
+		for (uint32_t i = 0; i < size; i++) {
+			((uint8_t *)dst)[i] = ((const uint8_t *)src)[i];
+		}
 		break;
 	}
 }
 
-static void cover_make(const struct co_od *od, const struct co_od_info *info,
-		       struct co_od_cover *cover)
+/*
+ * A PDO/SRDO write that needs no check and no hook but what the cover made: a RAM value such
+ * writers may write, whose C storage is its wire format, without limits or validate hooks.
+ */
+#define COVER_W_MASK                                                                               \
+	(CO_OD_COVER_DIRECT | CO_OD_COVER_COPY | CO_OD_COVER_MAP_W | CO_OD_COVER_CHECK |           \
+	 CO_OD_COVER_VALIDATE)
+#define COVER_W_COPY (CO_OD_COVER_DIRECT | CO_OD_COVER_COPY | CO_OD_COVER_MAP_W)
+
+/* Likewise for a read: such readers may read it, no read-check hook. */
+#define COVER_R_MASK                                                                               \
+	(CO_OD_COVER_DIRECT | CO_OD_COVER_COPY | CO_OD_COVER_MAP_R | CO_OD_COVER_READ_CHECK)
+#define COVER_R_COPY (CO_OD_COVER_DIRECT | CO_OD_COVER_COPY | CO_OD_COVER_MAP_R)
+
+static __attribute__((noinline)) void
+cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_cover *cover)
 {
 	uint16_t index = info->index;
-	uint8_t flags = CO_OD_COVER_MADE;
+	uint16_t flags = CO_OD_COVER_MADE | CO_OD_COVER_EXACT;
 
 	cover->first = UINT16_MAX;
 	cover->end = 0U;
@@ -1142,10 +1180,16 @@ static void cover_make(const struct co_od *od, const struct co_od_info *info,
 		const struct co_od_hook *h = &od->hooks[i];
 
 		if (!hook_covers(h, index, info->sub)) {
+			/* A hook between two covering ones: the range is not exact. */
+			if (cover->first != UINT16_MAX) {
+				flags &= (uint16_t)~CO_OD_COVER_EXACT;
+			}
 			continue;
 		}
 		if (cover->first == UINT16_MAX) {
 			cover->first = i;
+		} else if (cover->end != i) {
+			flags &= (uint16_t)~CO_OD_COVER_EXACT;
 		}
 		cover->end = i + 1U;
 		flags |= (h->validate != NULL ? CO_OD_COVER_VALIDATE : 0U) |
@@ -1163,6 +1207,27 @@ static void cover_make(const struct co_od *od, const struct co_od_info *info,
 			flags |= CO_OD_COVER_COPY;
 		}
 	}
+	/* The access checks of the PDO and SRDO writers and readers, made once. */
+	if (check_access(info, CO_OD_WRITER_PDO) == 0U) {
+		flags |= CO_OD_COVER_MAP_W;
+	}
+	if (check_read(info, CO_OD_WRITER_PDO) == 0U) {
+		flags |= CO_OD_COVER_MAP_R;
+	}
+	/* One hook, a notify one: the pass is one call, nothing can follow it. */
+	if ((flags & (CO_OD_COVER_EXACT | CO_OD_COVER_NOTIFY)) ==
+		    (CO_OD_COVER_EXACT | CO_OD_COVER_NOTIFY) &&
+	    cover->end == cover->first + 1U) {
+		flags |= CO_OD_COVER_NOTIFY1;
+	}
+	/* What the inline accessors of od.h do alone: copy, then at most one notify call. */
+	if ((flags & COVER_W_MASK) == COVER_W_COPY &&
+	    ((flags & CO_OD_COVER_NOTIFY) == 0U || (flags & CO_OD_COVER_NOTIFY1) != 0U)) {
+		flags |= CO_OD_COVER_W_FAST;
+	}
+	if ((flags & COVER_R_MASK) == COVER_R_COPY) {
+		flags |= CO_OD_COVER_R_FAST;
+	}
 	cover->flags = flags;
 	cover->gen = od->hook_gen;
 }
@@ -1170,24 +1235,59 @@ static void cover_make(const struct co_od *od, const struct co_od_info *info,
 static inline void cover_refresh(const struct co_od *od, const struct co_od_info *info,
 				 struct co_od_cover *cover)
 {
-	if ((cover->flags & CO_OD_COVER_MADE) == 0U || cover->gen != od->hook_gen) {
+	/* hook_gen is never 0: a zeroed cover is made at first use. */
+	if (OD_UNLIKELY(cover->gen != od->hook_gen)) {
 		cover_make(od, info, cover);
 	}
 }
 
-uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
-			    struct co_od_cover *cover, const void *data, size_t len,
-			    enum co_od_writer writer)
+static inline bool pdo_or_srdo(enum co_od_writer w)
 {
-	OD_ASSERT_LOCKED(od);
-	cover_refresh(od, info, cover);
-	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || len != info->size) {
-		return co_od_write_info(od, info, data, len, writer);
-	}
-	/* finish_write() of a fixed-size RAM value, the hook scans limited to the cover. */
-	uint32_t ab = check_access(info, writer);
+	return w == CO_OD_WRITER_PDO || w == CO_OD_WRITER_SRDO;
+}
 
-	if (ab == 0U && (cover->flags & CO_OD_COVER_CHECK) != 0U) {
+/*
+ * The notify pass of a fresh cover whose hooks are exactly [first, end): no search, no
+ * coverage test. A hook that changes the table hands the rest of the pass to notify_from(),
+ * which goes on exactly as run_notify_at() would have.
+ */
+static inline __attribute__((always_inline)) void
+run_notify_cover(struct co_od *od, const struct co_od_req *req, const struct co_od_cover *cover)
+{
+	uint32_t gen = od->hook_gen;
+	uint32_t limit = od->hook_next_seq;
+	uint16_t i = cover->first;
+
+	do {
+		const struct co_od_hook *h = &od->hooks[i];
+
+		if (h->notify != NULL) {
+			uint16_t first = h->index_first;
+			uint32_t seq = od->hook_seq[i];
+
+			h->notify(od, req, h->user_data);
+			if (OD_UNLIKELY(od->hook_gen != gen)) {
+				notify_from(od, req, hooks_after(od, first, seq), UINT16_MAX,
+					    limit);
+				return;
+			}
+		}
+	} while (++i < cover->end);
+}
+
+/* finish_write() of a fixed-size RAM value, the hook scans limited to a fresh cover. */
+static __attribute__((noinline)) uint32_t write_covered(struct co_od *od,
+							const struct co_od_info *info,
+							struct co_od_cover *cover, const void *data,
+							size_t len, enum co_od_writer writer)
+{
+	uint16_t flags = cover->flags;
+	uint32_t ab = 0U;
+
+	if ((flags & CO_OD_COVER_MAP_W) == 0U || !pdo_or_srdo(writer)) {
+		ab = check_access(info, writer);
+	}
+	if (ab == 0U && (flags & CO_OD_COVER_CHECK) != 0U) {
 		ab = check_value(od, info, data);
 	}
 	if (ab != 0U) {
@@ -1196,7 +1296,7 @@ uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
 	struct co_od_req req = {.info = info, .writer = writer, .data = data, .len = len};
 	uint32_t gen = od->hook_gen;
 
-	if ((cover->flags & CO_OD_COVER_VALIDATE) != 0U) {
+	if ((flags & CO_OD_COVER_VALIDATE) != 0U) {
 		ab = run_validate_at(od, &req, cover->first, cover->end);
 		if (ab != 0U && ab != CO_OD_HANDLED) {
 			return ab;
@@ -1205,34 +1305,112 @@ uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
 	if (ab == 0U) {
 		uint8_t *mem = od->ram + info->desc->offset;
 
-		if ((cover->flags & CO_OD_COVER_COPY) != 0U) {
+		if ((flags & CO_OD_COVER_COPY) != 0U) {
 			copy_fixed(mem, data, info->size);
 		} else {
 			decode_fixed(info->dtype, data, mem);
 		}
 	}
-	if (od->hook_gen != gen) {
+	if (OD_UNLIKELY(od->hook_gen != gen)) {
 		/* A validate hook changed the table: the cover is stale. */
 		run_notify(od, &req);
-	} else if ((cover->flags & CO_OD_COVER_NOTIFY) != 0U) {
-		run_notify_at(od, &req, cover->first, cover->end);
+	} else if ((flags & CO_OD_COVER_NOTIFY) != 0U) {
+		if ((flags & CO_OD_COVER_EXACT) != 0U) {
+			run_notify_cover(od, &req, cover);
+		} else {
+			run_notify_at(od, &req, cover->first, cover->end);
+		}
 	}
 	return 0U;
 }
 
-uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
-			   struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
-			   enum co_od_writer reader)
+/* The value is written (a copy by a PDO/SRDO writer): the notify hooks of a fresh cover. */
+static __attribute__((noinline)) uint32_t write_notify(struct co_od *od,
+						       const struct co_od_info *info,
+						       const struct co_od_cover *cover,
+						       const void *data, size_t len,
+						       enum co_od_writer writer)
+{
+	const struct co_od_req req = {.info = info, .writer = writer, .data = data, .len = len};
+
+	if (OD_UNLIKELY((cover->flags & CO_OD_COVER_EXACT) == 0U)) {
+		run_notify_at(od, &req, cover->first, cover->end);
+	} else {
+		run_notify_cover(od, &req, cover);
+	}
+	return 0U;
+}
+
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_od_assert_locked(const struct co_od *od)
 {
 	OD_ASSERT_LOCKED(od);
-	cover_refresh(od, info, cover);
-	if ((cover->flags & CO_OD_COVER_DIRECT) == 0U || cap < info->size) {
-		return co_od_read_info(od, info, 0, buf, cap, len, reader);
+}
+#endif
+
+/* A stale cover: make it, then write through it. */
+static __attribute__((noinline)) uint32_t write_remade(struct co_od *od,
+						       const struct co_od_info *info,
+						       struct co_od_cover *cover, const void *data,
+						       size_t len, enum co_od_writer writer)
+{
+	cover_make(od, info, cover);
+	return co_od_write_cover(od, info, cover, data, len, writer);
+}
+
+/*
+ * The common PDO case is leaf code: every check was made with the cover, so a fresh cover
+ * of a plain value costs a comparison of generations and a copy; anything else goes out of
+ * line (tail calls).
+ */
+uint32_t co_od_write_cover(struct co_od *od, const struct co_od_info *info,
+			   struct co_od_cover *cover, const void *data, size_t len,
+			   enum co_od_writer writer)
+{
+	OD_ASSERT_LOCKED(od);
+	if (OD_UNLIKELY(cover->gen != od->hook_gen)) {
+		/* hook_gen is never 0: a zeroed cover is made here at first use. */
+		return write_remade(od, info, cover, data, len, writer);
 	}
+
+	uint16_t flags = cover->flags;
+
+	if (OD_UNLIKELY((flags & CO_OD_COVER_DIRECT) == 0U || len != info->size)) {
+		return co_od_write_info(od, info, data, len, writer);
+	}
+	if ((flags & COVER_W_MASK) != COVER_W_COPY || !pdo_or_srdo(writer)) {
+		return write_covered(od, info, cover, data, len, writer);
+	}
+	copy_fixed(od->ram + info->desc->offset, data, len);
+	if ((flags & CO_OD_COVER_NOTIFY1) != 0U) {
+		/*
+		 * The notify pass of one hook: it ran when the pass began and was the only one;
+		 * hooks it adds join from the next write on, so nothing follows it.
+		 */
+		const struct co_od_req req = {
+			.info = info, .writer = writer, .data = data, .len = len};
+		const struct co_od_hook *h = &od->hooks[cover->first];
+
+		h->notify(od, &req, h->user_data);
+		return 0U;
+	}
+	if ((flags & CO_OD_COVER_NOTIFY) != 0U) {
+		return write_notify(od, info, cover, data, len, writer);
+	}
+	return 0U;
+}
+
+/* co_od_read_info() of a fixed-size RAM value, the read-check scan limited to a fresh cover. */
+static __attribute__((noinline)) uint32_t read_covered(const struct co_od *od,
+						       const struct co_od_info *info,
+						       const struct co_od_cover *cover, void *buf,
+						       size_t *len, enum co_od_writer reader)
+{
+	uint16_t flags = cover->flags;
 	uint32_t ab = check_read(info, reader);
 
 	*len = 0;
-	if (ab == 0U && (cover->flags & CO_OD_COVER_READ_CHECK) != 0U) {
+	if (ab == 0U && (flags & CO_OD_COVER_READ_CHECK) != 0U) {
 		ab = run_read_check_at(od, info, reader, cover->first, cover->end);
 	}
 	if (ab != 0U) {
@@ -1240,7 +1418,7 @@ uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info
 	}
 	const uint8_t *mem = od->ram + info->desc->offset;
 
-	if ((cover->flags & CO_OD_COVER_COPY) != 0U) {
+	if ((flags & CO_OD_COVER_COPY) != 0U) {
 		copy_fixed(buf, mem, info->size);
 	} else {
 		uint8_t tmp[8];
@@ -1248,6 +1426,40 @@ uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info
 		co_od_encode_fixed(info->dtype, mem, tmp);
 		memcpy(buf, tmp, info->size);
 	}
+	*len = info->size;
+	return 0U;
+}
+
+/* A stale cover: make it, then read through it. */
+static __attribute__((noinline)) uint32_t read_remade(const struct co_od *od,
+						      const struct co_od_info *info,
+						      struct co_od_cover *cover, void *buf,
+						      size_t cap, size_t *len,
+						      enum co_od_writer reader)
+{
+	cover_make(od, info, cover);
+	return co_od_read_cover(od, info, cover, buf, cap, len, reader);
+}
+
+/* As co_od_write_cached(): the common TPDO case is leaf code, the rest out of line. */
+uint32_t co_od_read_cover(const struct co_od *od, const struct co_od_info *info,
+			  struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
+			  enum co_od_writer reader)
+{
+	OD_ASSERT_LOCKED(od);
+	if (OD_UNLIKELY(cover->gen != od->hook_gen)) {
+		return read_remade(od, info, cover, buf, cap, len, reader);
+	}
+
+	uint16_t flags = cover->flags;
+
+	if (OD_UNLIKELY((flags & CO_OD_COVER_DIRECT) == 0U || cap < info->size)) {
+		return co_od_read_info(od, info, 0, buf, cap, len, reader);
+	}
+	if ((flags & COVER_R_MASK) != COVER_R_COPY || !pdo_or_srdo(reader)) {
+		return read_covered(od, info, cover, buf, len, reader);
+	}
+	copy_fixed(buf, od->ram + info->desc->offset, info->size);
 	*len = info->size;
 	return 0U;
 }

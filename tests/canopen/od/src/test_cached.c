@@ -160,4 +160,108 @@ ZTEST(od_cached, test_read_same_as_generic_and_read_check)
 		      CO_SDO_AB_NO_DATA, "a read check added later is seen");
 }
 
+/*
+ * The pass of the covering notify hooks through a cover, whatever its shape: one hook (the
+ * inline path), hooks next to each other, and hooks with one between them that covers
+ * another sub-index. Each covering hook runs once, in registration order, the other never.
+ */
+static int order[8];
+static int n_order;
+
+static void o_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	order[n_order++] = (int)(intptr_t)user_data;
+}
+
+static void order_hook(uint8_t sub_first, uint8_t sub_last, int tag)
+{
+	const struct co_od_hook h = {
+		0x6000, 0x6000, sub_first, sub_last, NULL, o_notify, (void *)(intptr_t)tag};
+
+	zassert_ok(co_od_hook_register(&fx.od, &h));
+}
+
+static void write_u32_cached(struct co_od_cover *cover, uint32_t v)
+{
+	struct co_od_info info;
+	uint8_t data[4];
+
+	co_od_le_put(data, 4, v);
+	zassert_ok(co_od_find(&fx.od, 0x6000, 7, &info));
+	zassert_ok(co_od_write_cached(&fx.od, &info, cover, data, 4, CO_OD_WRITER_PDO));
+}
+
+ZTEST(od_cached, test_notify_pass_of_every_cover_shape)
+{
+	struct co_od_cover cover = {0};
+
+	n_order = 0;
+	order_hook(7, 7, 1);
+	write_u32_cached(&cover, 1);
+	zassert_equal(n_order, 1, "one hook: one call");
+	zassert_equal(order[0], 1);
+
+	order_hook(6, 8, 2);
+	n_order = 0;
+	write_u32_cached(&cover, 2);
+	zassert_equal(n_order, 2, "two hooks next to each other");
+	zassert_equal(order[0], 1);
+	zassert_equal(order[1], 2);
+
+	order_hook(1, 3, 3); /* same index_first: between them and the next one, not covering */
+	order_hook(7, 7, 4);
+	n_order = 0;
+	write_u32_cached(&cover, 3);
+	zassert_equal(n_order, 3, "the hook on 6000h:01-03 is not called");
+	zassert_equal(order[0], 1);
+	zassert_equal(order[1], 2);
+	zassert_equal(order[2], 4);
+	zassert_equal(co_od_hook_unregister(&fx.od, (void *)(intptr_t)1), 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, (void *)(intptr_t)2), 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, (void *)(intptr_t)3), 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, (void *)(intptr_t)4), 1);
+}
+
+/* A single notify hook (the one-call pass) that registers and removes hooks as it runs. */
+static struct probe late;
+static int grow_calls;
+static bool grow_add;
+
+static void grow_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	grow_calls++;
+	if (grow_add) {
+		grow_add = false;
+		probe_hook(od, 0x6000, 7, &late);
+	}
+}
+
+ZTEST(od_cached, test_one_notify_hook_that_changes_the_table)
+{
+	const struct co_od_hook h = {0x6000, 0x6000, 7, 7, NULL, grow_notify, &grow_calls};
+	struct co_od_cover cover = {0};
+	uint32_t u = 0;
+
+	memset(&late, 0, sizeof(late));
+	grow_calls = 0;
+	grow_add = false;
+	zassert_ok(co_od_hook_register(&fx.od, &h));
+	write_u32_cached(&cover, 1);
+	zassert_equal(grow_calls, 1);
+
+	grow_add = true;
+	write_u32_cached(&cover, 2);
+	zassert_equal(grow_calls, 2, "the hook ran once");
+	zassert_equal(late.validated + late.notified, 0, "a hook added by the pass waits");
+	zassert_ok(co_od_get_u32(&fx.od, 0x6000, 7, &u));
+	zassert_equal(u, 2);
+
+	write_u32_cached(&cover, 3);
+	zassert_equal(grow_calls, 3);
+	zassert_equal(late.validated, 1, "and joins at the next write");
+	zassert_equal(late.notified, 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, &late), 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, &grow_calls), 1);
+}
+
 ZTEST_SUITE(od_cached, NULL, NULL, fx_before, NULL, NULL);
