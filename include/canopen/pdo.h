@@ -126,9 +126,11 @@ struct co_pdo_map_ent {
 /* A compiled mapping: entries in frame order, bit offsets implied by their lengths. */
 struct co_pdo_map {
 	struct co_pdo_map_ent ent[CO_PDO_MAP_ENTRIES];
+	/* co_od.hook_gen when every entry was found a plain copy, 0 if not (pdo_internal.h) */
+	uint32_t fast_gen;
 	uint8_t n;     /* entries in use */
 	uint8_t bits;  /* total mapped length, 0..64 */
-	bool bytewise; /* every entry is a whole number of bytes (fast path) */
+	bool bytewise; /* every entry is a whole number of bytes */
 };
 
 struct co_rpdo {
@@ -187,6 +189,7 @@ struct co_pdo {
 	uint64_t window_end; /* end of the SYNC window of the last SYNC */
 	bool window;         /* window_end applies */
 	bool operational;
+	bool rx_sync_pending; /* an RPDO may hold a frame for the next SYNC (sync_pending) */
 	co_rpdo_ind_t rpdo_ind;
 	void *rpdo_ind_user_data;
 	co_tpdo_ind_t tpdo_ind;

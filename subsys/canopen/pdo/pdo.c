@@ -168,6 +168,7 @@ static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n
 		out->n = 0U;
 		out->bits = 0U;
 		out->bytewise = true;
+		out->fast_gen = 0U;
 	}
 	if (n > CO_PDO_MAP_ENTRIES) {
 		return CO_SDO_AB_MAP_LEN;
@@ -329,8 +330,11 @@ static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 		rpdo_error(r, ERR_SHORT, true);
 		return;
 	}
-	rpdo_error(r, ERR_SHORT, false);
-	rpdo_error(r, ERR_LONG, frame->dlc > mapped);
+	/* Nothing to raise or clear for a frame of the mapped length on an RPDO without one. */
+	if (unlikely((r->errors & (ERR_SHORT | ERR_LONG)) != 0U || frame->dlc > mapped)) {
+		rpdo_error(r, ERR_SHORT, false);
+		rpdo_error(r, ERR_LONG, frame->dlc > mapped);
+	}
 	if (r->event_ms != 0U) {
 		co_node_timer_start(node, &r->timer, now_us + (uint64_t)r->event_ms * 1000U);
 		rpdo_error(r, ERR_TIMEOUT, false);
@@ -347,9 +351,17 @@ static void rpdo_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 		memcpy(r->sync_data, frame->data, mapped);
 		r->sync_dlc = mapped;
 		r->sync_pending = true;
+		pdo->rx_sync_pending = true;
 		return;
 	}
 	(void)co_pdo_map_unpack(&node->od, &r->map, frame->data);
+	rpdo_indicate(r);
+}
+
+/* A synchronous RPDO at its SYNC: out of line, the frame path keeps the inlined copy. */
+static __attribute__((noinline)) void rpdo_commit(struct co_rpdo *r, const uint8_t *data)
+{
+	(void)co_pdo_map_unpack(&r->node->od, &r->map, data);
 	rpdo_indicate(r);
 }
 
@@ -385,7 +397,7 @@ static void rpdo_configure(struct co_rpdo *r)
 
 /* --- TPDO --------------------------------------------------------------------------------- */
 
-static void tpdo_sample(struct co_tpdo *t)
+static ALWAYS_INLINE void tpdo_sample_now(struct co_tpdo *t)
 {
 	struct co_pdo *pdo = &t->node->pdo;
 
@@ -395,6 +407,12 @@ static void tpdo_sample(struct co_tpdo *t)
 		t->sampling = false;
 	}
 	t->dlc = co_pdo_map_pack(&t->node->od, &t->map, t->buf);
+}
+
+/* Inlined where a SYNC samples (the hot path), a call elsewhere. */
+static __attribute__((noinline)) void tpdo_sample(struct co_tpdo *t)
+{
+	tpdo_sample_now(t);
 }
 
 static bool tpdo_inhibited(const struct co_tpdo *t, uint64_t now)
@@ -648,11 +666,10 @@ static void cos_hooks_update(struct co_tpdo *t)
 static void tpdo_sync(struct co_tpdo *t, uint8_t counter, uint64_t now)
 {
 	if (t->type == CO_PDO_TT_SYNC_ACYCLIC) {
-		if (t->event) {
-			t->event = false;
-			tpdo_sample(t);
-			tpdo_send_sample(t, now);
+		if (!t->event) {
+			return;
 		}
+		t->event = false;
 	} else if (t->type <= CO_PDO_TT_SYNC_MAX) {
 		if (!t->started) {
 			/* With a counter and a start value, counting starts at the matching SYNC.
@@ -663,15 +680,19 @@ static void tpdo_sync(struct co_tpdo *t, uint8_t counter, uint64_t now)
 			t->started = true;
 			t->sync_count = 0U;
 		}
-		if (++t->sync_count >= t->type) {
-			t->sync_count = 0U;
-			tpdo_sample(t);
-			tpdo_send_sample(t, now);
+		if (++t->sync_count < t->type) {
+			return;
 		}
-	} else if (t->type == CO_PDO_TT_RTR_SYNC) {
-		tpdo_sample(t);
-		t->sampled = true;
+		t->sync_count = 0U;
+	} else {
+		if (t->type == CO_PDO_TT_RTR_SYNC) {
+			tpdo_sample(t);
+			t->sampled = true;
+		}
+		return;
 	}
+	tpdo_sample_now(t);
+	tpdo_send_sample(t, now);
 }
 
 /* A SYNC: synchronous TPDOs sampled and sent, synchronous RPDOs committed (CiA 301 §7.2.2.2). */
@@ -692,15 +713,22 @@ static void pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uin
 			tpdo_sync(t, counter, now_us);
 		}
 	}
+	if (!pdo->rx_sync_pending) {
+		return;
+	}
+	pdo->rx_sync_pending = false;
 	for (int i = 0; i < CO_RPDOS; i++) {
 		struct co_rpdo *r = &pdo->rpdo[i];
 
 		if (r->present && r->sync_pending && cob_valid(r->cob_id) &&
 		    is_sync_type(r->type)) {
 			r->sync_pending = false;
-			(void)co_pdo_map_unpack(&node->od, &r->map, r->sync_data);
-			rpdo_indicate(r);
+			rpdo_commit(r, r->sync_data);
 		}
+		/* One that cannot be committed now stays counted (and an indication may have
+		 * received another).
+		 */
+		pdo->rx_sync_pending |= r->sync_pending;
 	}
 }
 

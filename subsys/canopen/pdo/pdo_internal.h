@@ -15,6 +15,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <zephyr/toolchain.h>
+
 #include <canopen/od.h>
 #include <canopen/pdo.h>
 
@@ -59,13 +61,73 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 void co_pdo_bits_put(uint8_t *dst, unsigned int off, unsigned int n, const uint8_t *src);
 void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8_t *dst);
 
-/* Sample every mapped object into data[8]; returns the frame length in bytes. */
-uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8]);
+/*
+ * Frames and objects. A mapping whose entries are all whole objects in whole bytes, each a
+ * plain value for the PDO (co_od_cover_plain_write()/_read(): a copy, and for an RPDO at most
+ * one notify hook), is marked with the hook generation at which it was found so
+ * (map->fast_gen); while the dictionary's hook table stays as it was, a frame is a copy per
+ * object and no per-object test. Anything else, and the first frame after a change, goes
+ * through the cached accessors entry by entry (pdo_map.c), which then mark the mapping again.
+ */
 
-/* Write every mapped object from data (at least the mapped bytes long); dummies are skipped.
+/* The general path of co_pdo_map_pack() (pdo_map.c). */
+uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8]);
+
+/* The general path of co_pdo_map_unpack(), from entry @p from on at byte/bit offset @p off. */
+int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_t *data,
+			  uint8_t from, unsigned int off);
+
+/* Sample every mapped object into data[8] (zero above the mapped bits); returns the frame
+ * length in bytes. A refused read leaves zeros.
+ */
+static ALWAYS_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
+					     uint8_t data[8])
+{
+	if (likely(map->fast_gen == od->hook_gen)) {
+		uint8_t frame[8] = {0};
+		unsigned int off = 0;
+
+		for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
+			unsigned int bytes = ent->bits / 8U;
+
+			(void)co_od_copy_word(&frame[off], od->ram + ent->info.desc->offset, bytes);
+			off += bytes;
+		}
+		memcpy(data, frame, sizeof(frame));
+		return (uint8_t)(off);
+	}
+	return co_pdo_map_pack_gen(od, map, data);
+}
+
+/*
+ * Write every mapped object from data (at least the mapped bytes long); dummies are skipped.
  * Returns the number of objects whose write was refused.
  */
-int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data);
+static ALWAYS_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map,
+					   const uint8_t *data)
+{
+	uint32_t gen = od->hook_gen;
+
+	if (likely(map->fast_gen == gen)) {
+		unsigned int off = 0;
+
+		for (uint8_t i = 0; i < map->n; i++) {
+			struct co_pdo_map_ent *ent = &map->ent[i];
+			unsigned int bytes = ent->bits / 8U;
+
+			(void)co_od_copy_word(od->ram + ent->info.desc->offset, &data[off], bytes);
+			co_od_cover_notify(od, &ent->info, &ent->cover, &data[off], bytes,
+					   CO_OD_WRITER_PDO);
+			off += bytes;
+			/* A hook that changed the hook table: the rest entry by entry. */
+			if (unlikely(od->hook_gen != gen)) {
+				return co_pdo_map_unpack_gen(od, map, data, i + 1U, off);
+			}
+		}
+		return 0;
+	}
+	return co_pdo_map_unpack_gen(od, map, data, 0U, 0U);
+}
 
 struct co_node;
 struct can_frame;

@@ -155,64 +155,81 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 	return co_od_write_cached(od, &ent->info, &ent->cover, buf, size, writer);
 }
 
-uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8])
+/* Whether every entry of a mapping is a plain copy now (see pdo_internal.h). */
+static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool rx)
 {
-	unsigned int off = 0;
+	if (!map->bytewise) {
+		return false;
+	}
+	for (uint8_t i = 0; i < map->n; i++) {
+		const struct co_pdo_map_ent *ent = &map->ent[i];
+		unsigned int bytes = ent->bits / 8U;
+
+		if (!ent->whole || co_pdo_ent_is_dummy(ent) || ent->info.desc == NULL ||
+		    (bytes != 1U && bytes != 2U && bytes != 4U && bytes != 8U) ||
+		    !(rx ? co_od_cover_plain_write(od, &ent->cover)
+			 : co_od_cover_plain_read(od, &ent->cover))) {
+			return false;
+		}
+	}
+	return true;
+}
+
+uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8])
+{
 	uint8_t val[8];
+	unsigned int off = 0;
 
 	memset(data, 0, 8);
 	for (uint8_t i = 0; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
+		size_t len;
 
 		if (map->bytewise && ent->whole) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
-			size_t len = 0;
-
 			if (co_od_read_cached(od, &ent->info, &ent->cover, &data[off / 8U],
 					      ent->bits / 8U, &len, CO_OD_WRITER_PDO) != 0U) {
 				memset(&data[off / 8U], 0, ent->bits / 8U);
 			}
-			off += ent->bits;
-			continue;
-		}
-		(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
-		if (map->bytewise) {
-			memcpy(&data[off / 8U], val, ent->bits / 8U);
 		} else {
-			co_pdo_bits_put(data, off, ent->bits, val);
+			(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
+			if (map->bytewise) {
+				memcpy(&data[off / 8U], val, ent->bits / 8U);
+			} else {
+				co_pdo_bits_put(data, off, ent->bits, val);
+			}
 		}
 		off += ent->bits;
 	}
+	map->fast_gen = map_plain(od, map, false) ? od->hook_gen : 0U;
 	return (uint8_t)((map->bits + 7U) / 8U);
 }
 
-int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data)
+int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_t *data,
+			  uint8_t from, unsigned int off)
 {
-	unsigned int off = 0;
-	int refused = 0;
 	uint8_t val[8];
+	int refused = 0;
 
-	for (uint8_t i = 0; i < map->n; i++) {
+	/* Byte-wise mappings count bytes, bit-wise ones bits. */
+	for (uint8_t i = from; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
 
 		if (map->bytewise && ent->whole) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
-			if (co_od_write_cached(od, &ent->info, &ent->cover, &data[off / 8U],
-					       ent->bits / 8U, CO_OD_WRITER_PDO) != 0U) {
-				refused++;
-			}
+			refused += co_od_write_cached(od, &ent->info, &ent->cover, &data[off],
+						      ent->bits / 8U, CO_OD_WRITER_PDO) != 0U;
 		} else if (!co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));
 			if (map->bytewise) {
-				memcpy(val, &data[off / 8U], ent->bits / 8U);
+				memcpy(val, &data[off], ent->bits / 8U);
 			} else {
 				co_pdo_bits_get(data, off, ent->bits, val);
 			}
-			if (co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO) != 0U) {
-				refused++;
-			}
+			refused += co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO) != 0U;
 		}
-		off += ent->bits;
+		off += map->bytewise ? ent->bits / 8U : ent->bits;
 	}
+	map->fast_gen = map_plain(od, map, true) ? od->hook_gen : 0U;
 	return refused;
 }

@@ -394,6 +394,112 @@ ZTEST(co_pdo, test_rpdo_write_is_change_of_state_of_a_tpdo_mapped_later)
 	zassert_equal(get_u8(0x2000, 1), 0x33);
 }
 
+/*
+ * A frame's objects are written one after the other as separate writes would be, also when
+ * a hook changes the hook table half way: the notify hook of 2000h:01 adds a validate hook
+ * that refuses every write of 2001h, so the second object of that same frame is refused.
+ */
+static int guard_calls;
+static bool guard_arm;
+
+static uint32_t refuse_2001(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	guard_calls++;
+	return CO_SDO_AB_VALUE_HIGH;
+}
+
+static void arm_guard(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	const struct co_od_hook guard = {0x2001, 0x2001, 0, 0, refuse_2001, NULL, &guard_calls};
+
+	if (guard_arm) {
+		guard_arm = false;
+		zassert_ok(co_od_hook_register(od, &guard));
+	}
+}
+
+static uint16_t get_u16(uint16_t index, uint8_t sub)
+{
+	uint16_t v = 0xEEEE;
+
+	co_node_lock(&t.node);
+	zassert_ok(co_od_get_u16(co_node_od(&t.node), index, sub, &v));
+	co_node_unlock(&t.node);
+	return v;
+}
+
+ZTEST(co_pdo, test_rpdo_hook_that_changes_the_hook_table_mid_frame)
+{
+	const struct co_od_hook arm = {0x2000, 0x2000, 1, 1, NULL, arm_guard, &guard_arm};
+
+	guard_calls = 0;
+	guard_arm = false;
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &arm));
+	co_node_unlock(&t.node);
+	go_operational();
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x11, 0x22, 0x33});
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x12, 0x23, 0x34});
+	zassert_equal(get_u8(0x2000, 1), 0x12);
+	zassert_equal(get_u16(0x2001, 0), 0x3423);
+
+	guard_arm = true;
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x13, 0x24, 0x35});
+	zassert_equal(get_u8(0x2000, 1), 0x13, "written before the hook table changed");
+	zassert_equal(guard_calls, 1, "the new hook sees the rest of the frame");
+	zassert_equal(get_u16(0x2001, 0), 0x3423, "refused: the old value stays");
+	zassert_equal(t.n_rpdo_ind, 3, "the indication still runs");
+
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &guard_calls), 1);
+	co_node_unlock(&t.node);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x14, 0x25, 0x36});
+	zassert_equal(get_u16(0x2001, 0), 0x3625, "and the mapping is plain again");
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &guard_arm), 1);
+	co_node_unlock(&t.node);
+}
+
+/* A read check registered on a mapped object after the TPDO went out is heard: zeros. */
+static uint32_t no_read_2002(const struct co_od *od, const struct co_od_info *info,
+			     enum co_od_writer reader, void *user_data)
+{
+	return CO_SDO_AB_NO_DATA;
+}
+
+static void no_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+}
+
+ZTEST(co_pdo, test_tpdo_read_check_registered_later)
+{
+	const struct co_od_hook check = {0x2002, 0x2002, 0, 0, NULL, no_notify, &sim, no_read_2002};
+	const uint8_t want[5] = {0xAB, 0x78, 0x56, 0x34, 0x12};
+	const uint8_t zeros[5] = {0xAB, 0, 0, 0, 0};
+
+	go_operational();
+	app_u8(0x2000, 5, 0xAB);
+	app_u32(0x2002, 0, 0x12345678);
+	sim.n_sent = 0;
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(sim.n_sent, 2);
+	zassert_mem_equal(sim.sent[1].data, want, 5);
+
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &check));
+	co_node_unlock(&t.node);
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(sim.n_sent, 3);
+	zassert_mem_equal(sim.sent[2].data, zeros, 5, "a refused read sends zeros");
+
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &sim), 1);
+	co_node_unlock(&t.node);
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_mem_equal(sim.sent[3].data, want, 5);
+}
+
 ZTEST(co_pdo, test_tpdo_inhibit_defers_and_merges)
 {
 	zassert_equal(co_sim_write(&t.node, 0x1800, 3, 100, 2), CO_SDO_AB_INVALID_VALUE,
