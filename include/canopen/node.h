@@ -80,6 +80,12 @@ typedef uint8_t co_route_t;
  * them on both lines; the ECSS profile of the redundancy service on the active line alone).
  */
 #define CO_ROUTE_PROCESS   BIT(6)
+/**
+ * The lines the node's heartbeat and boot-up take: those of CO_ROUTE_PROCESS, including a
+ * line left out of CO_ROUTE_PROCESS by co_node_set_tx_excluded() (so that the others see the
+ * node on it again when it recovers).
+ */
+#define CO_ROUTE_EC        BIT(5)
 /** @} */
 
 /** @cond INTERNAL_HIDDEN */
@@ -106,6 +112,8 @@ struct co_node {
 	uint8_t rx_line;
 	/* What CO_ROUTE_PROCESS means (co_node_set_process_route()). */
 	co_route_t process_route;
+	/* Lines left out of CO_ROUTE_PROCESS (co_node_set_tx_excluded()). */
+	co_route_t tx_excluded;
 	struct co_od od;
 	uint8_t node_id;
 	/* Node-ID to use from the next Reset Communication (LSS may change it). */
@@ -259,7 +267,7 @@ static inline int co_node_send(struct co_node *node, co_route_t route,
 			       const struct can_frame *frame)
 {
 	if (node->lines[CO_LINE_REDUNDANT].line == NULL &&
-	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE | CO_ROUTE_PROCESS)) != 0U) {
+	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE | CO_ROUTE_PROCESS | CO_ROUTE_EC)) != 0U) {
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
 		co_node_assert_locked(node);
 #endif
@@ -314,6 +322,17 @@ int co_node_dispatch_from(struct co_node *node, enum co_node_line_id idx,
  * @retval -EINVAL Another route.
  */
 int co_node_set_process_route(struct co_node *node, co_route_t route);
+
+/**
+ * @brief Leave lines out of CO_ROUTE_PROCESS (their controller cannot send, e.g. error
+ * passive after a cut, or bus-off), so that process data do not pile up behind them and go
+ * out stale later. CO_ROUTE_EC still reaches them. A route that would be left without any
+ * line keeps all of its lines.
+ *
+ * @param node The node.
+ * @param lines CO_ROUTE_DEFAULT and/or CO_ROUTE_REDUNDANT, or 0.
+ */
+void co_node_set_tx_excluded(struct co_node *node, co_route_t lines);
 
 /**
  * @brief Free places in the TX queues of a route (the smallest of its lines).

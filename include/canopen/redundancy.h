@@ -113,7 +113,8 @@ typedef bool (*co_rdn_veto_t)(struct co_node *node, enum co_rdn_event why, uint8
 /* One supervised node's heartbeat on one line. */
 struct co_rdn_hb {
 	uint64_t deadline;
-	uint8_t count; /* heartbeats since the last loss, up to 3 */
+	uint64_t counted_at; /* the last heartbeat counted as a good cycle */
+	uint8_t count;       /* heartbeats since the last loss, up to 3 */
 	bool seen;
 	bool lost;
 };
@@ -132,6 +133,8 @@ struct co_redundancy {
 	uint8_t state; /* enum co_rdn_state */
 	uint16_t tpdo_errors;
 	uint8_t tpdo_max;
+	/* Lines whose controller cannot send (error passive, bus-off): no process data there. */
+	uint8_t tx_excluded;
 	bool tpdo_failed;
 	uint32_t switches;
 	co_rdn_veto_t veto;

@@ -262,7 +262,7 @@ static void send_bootup(struct co_node *node)
 		.data = {0U},
 	};
 
-	(void)co_node_send(node, CO_ROUTE_PROCESS, &f);
+	(void)co_node_send(node, CO_ROUTE_EC, &f);
 }
 
 /*
@@ -496,15 +496,26 @@ int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
 	return err;
 }
 
-static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
+static inline co_route_t active_resolve(const struct co_node *node, co_route_t route)
 {
-	if ((route & CO_ROUTE_PROCESS) != 0U) {
-		route = (co_route_t)((route & ~CO_ROUTE_PROCESS) | node->process_route);
-	}
 	if ((route & CO_ROUTE_ACTIVE) != 0U) {
 		route = (co_route_t)((route & ~CO_ROUTE_ACTIVE) | BIT(node->active_line));
 	}
 	return route;
+}
+
+static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
+{
+	co_route_t out = (co_route_t)(route & ~(CO_ROUTE_PROCESS | CO_ROUTE_EC));
+
+	if ((route & (CO_ROUTE_PROCESS | CO_ROUTE_EC)) != 0U) {
+		co_route_t lines = active_resolve(node, node->process_route);
+		co_route_t live = (co_route_t)(lines & ~node->tx_excluded);
+
+		/* Error control reaches every line; process data the lines that can send. */
+		out |= ((route & CO_ROUTE_EC) != 0U || live == 0U) ? lines : live;
+	}
+	return active_resolve(node, out);
 }
 
 /*
@@ -565,6 +576,13 @@ int co_node_dispatch_from(struct co_node *node, enum co_node_line_id idx,
 				 true);
 	node->rx_line = outer;
 	return n;
+}
+
+void co_node_set_tx_excluded(struct co_node *node, co_route_t lines)
+{
+	co_node_lock(node);
+	node->tx_excluded = (co_route_t)(lines & CO_ROUTE_BOTH);
+	co_node_unlock(node);
 }
 
 int co_node_set_process_route(struct co_node *node, co_route_t route)

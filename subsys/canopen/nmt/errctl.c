@@ -89,7 +89,7 @@ static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
 
 	/* Held (redundancy: TPDO supervision) the heartbeat stays silent, its cadence runs on. */
 	if (!node->ec.hb_held) {
-		send_state(node, 0U, CO_ROUTE_PROCESS);
+		send_state(node, 0U, CO_ROUTE_EC);
 	}
 	/* Keep the cadence; after a long stall start afresh rather than burst. */
 	if (co_time_before_eq(next, now_us)) {
@@ -105,7 +105,7 @@ static void hb_restart(struct co_node *node, bool send_now)
 		return;
 	}
 	if (send_now && !node->ec.hb_held) {
-		send_state(node, 0U, CO_ROUTE_PROCESS);
+		send_state(node, 0U, CO_ROUTE_EC);
 	}
 	co_node_timer_start(node, &node->ec.hb_timer,
 			    now_of(node) + (uint64_t)node->ec.hb_period_ms * 1000U);

@@ -23,6 +23,7 @@
 #include <errno.h>
 #include <string.h>
 
+#include <zephyr/drivers/can.h>
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
@@ -253,8 +254,15 @@ static void hb_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 
 	h->seen = true;
 	h->deadline = now_us + r->hb_us[i];
-	if (h->count < GOOD_HEARTBEATS) {
+	/*
+	 * A good cycle is a heartbeat at least half a consumer time after the last one counted:
+	 * heartbeats a cut line held back arrive in a burst when it comes back and are no proof
+	 * of three cycles.
+	 */
+	if (h->count < GOOD_HEARTBEATS &&
+	    (h->count == 0U || co_time_before_eq(h->counted_at + r->hb_us[i] / 2U, now_us))) {
 		h->count++;
+		h->counted_at = now_us;
 	}
 	if (h->lost) {
 		h->lost = false;
@@ -282,6 +290,37 @@ static void fwd_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 	(void)co_node_dispatch_from(rx->user_data, CO_LINE_REDUNDANT, frame, now_us);
 }
 
+/* --- Lines that cannot send ----------------------------------------------------------------- */
+
+/* What a line that cannot send keeps queued: NMT and error control (its recovery shows). */
+static bool keep_ec(const struct can_frame *frame, void *arg)
+{
+	ARG_UNUSED(arg);
+	return frame->id == CO_NMT_COB_ID || (frame->id & ~0x7fU) == CO_NMT_EC_COB_ID;
+}
+
+/*
+ * A controller in error passive (a cut line: no acknowledgement) or bus-off cannot send:
+ * process data queued behind it would go out stale when it recovers, as copies the other
+ * line delivered long before. Such a line gets no process data until its controller is back
+ * below error passive, and what the node queued there is withdrawn.
+ */
+static void line_state(struct co_node *node, uint8_t idx, int state)
+{
+	struct co_redundancy *r = &node->rdn;
+	uint8_t bit = (uint8_t)BIT(idx);
+	bool down = state == CAN_STATE_ERROR_PASSIVE || state == CAN_STATE_BUS_OFF;
+
+	if (down == ((r->tx_excluded & bit) != 0U) || state == CAN_STATE_STOPPED) {
+		return;
+	}
+	r->tx_excluded = down ? (uint8_t)(r->tx_excluded | bit) : (uint8_t)(r->tx_excluded & ~bit);
+	co_node_set_tx_excluded(node, r->tx_excluded);
+	if (down) {
+		(void)co_line_tx_purge(node->lines[idx].line, &node->lock, keep_ec, NULL);
+	}
+}
+
 /* --- TPDO 1 supervision --------------------------------------------------------------------- */
 
 static int node_event(struct co_node *node, const struct co_event *ev, void *user_data)
@@ -290,11 +329,18 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 	uint64_t now = co_node_time(node);
 
 	ARG_UNUSED(user_data);
+	if (ev->type == CO_EV_LINE) {
+		if (two_lines(node) && ev->line.event == CO_LINE_EV_CAN_STATE) {
+			line_state(node, ev->line.idx, ev->line.arg);
+		}
+		return 0;
+	}
 	if (ev->type != CO_EV_TPDO || ev->tpdo.num != 0U || r->tpdo_max == 0U) {
 		return 0;
 	}
+	/* Capped at the limit: twelve good sends resume after any number of failures. */
 	if (ev->tpdo.err != 0) {
-		r->tpdo_errors = (uint16_t)MIN(r->tpdo_errors + TPDO_FAIL_STEP, UINT16_MAX);
+		r->tpdo_errors = (uint16_t)MIN(r->tpdo_errors + TPDO_FAIL_STEP, r->tpdo_max);
 	} else if (r->tpdo_errors > 0U) {
 		r->tpdo_errors--;
 	}
@@ -367,7 +413,8 @@ static int rdn_init(struct co_node *node)
 	co_rx_init(&r->hb_rx, HB_COB_BASE, hb_rx, &node->lock, node);
 	r->hb_rx.mask = 0x780U;
 	co_timer_init(&r->timer, timer_handler, &node->lock, node);
-	co_listener_init(&r->listener, "redundancy", CO_EV_BIT(CO_EV_TPDO), node_event, NULL);
+	co_listener_init(&r->listener, "redundancy", CO_EV_BIT(CO_EV_TPDO) | CO_EV_BIT(CO_EV_LINE),
+			 node_event, NULL);
 
 	int err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 

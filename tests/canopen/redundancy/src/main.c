@@ -20,7 +20,9 @@
 #include <canopen/pdo.h>
 #include <canopen/redundancy.h>
 #include <canopen/sync.h>
+#include <zephyr/drivers/can.h>
 
+#include "line_internal.h"
 #include "rdn_test_od.h"
 
 #define NODE_ID 1
@@ -265,6 +267,24 @@ ZTEST(co_redundancy, test_49_the_application_vetoes_the_switch)
 	zassert_equal(t.veto_asked, 1);
 }
 
+ZTEST(co_redundancy, test_49_a_burst_of_held_back_heartbeats_is_not_three_cycles)
+{
+	enum co_rdn_state st;
+
+	boot_default_active();
+	heartbeats_until(BIT(R), BIT(D) | BIT(R), 400 * MS);
+	zassert_equal(active(&st), R);
+	/* A restored line delivers what it held back at once: three heartbeats of node 2. */
+	heartbeat(D, 2);
+	heartbeat(D, 2);
+	heartbeat(D, 2);
+	run_until(t.now + 1 * MS);
+	zassert_equal(active(&st), R, "one cycle, not three");
+	/* Then real cycles: 50 ms apart (at least half the consumer time). */
+	heartbeats_until(BIT(D) | BIT(R), BIT(D) | BIT(R), t.now + 110 * MS);
+	zassert_equal(active(&st), D, "the burst counted once, two real cycles after it");
+}
+
 /* --- Routing -------------------------------------------------------------------------------- */
 
 ZTEST(co_redundancy, test_heartbeat_and_tpdo_go_on_both_lines)
@@ -321,6 +341,50 @@ ZTEST(co_redundancy, test_sync_counts_from_the_active_line_only)
 	zassert_equal(t.n_sync, 2);
 }
 
+ZTEST(co_redundancy, test_a_line_that_cannot_send_gets_no_process_data_and_drops_its_backlog)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	struct co_line_stats stats;
+
+	rx(D, 0x000, 2, start);
+	/* The default line's controller goes error passive (a cut): frames pile up there. */
+	t.busy = true;
+	co_line_inject_event(&t.line[D], CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	co_line_get_stats(&t.line[D], &stats);
+	t.busy = false;
+	run_until(t.now + 1 * MS);
+	t.n_tx[D] = t.n_tx[R] = 0;
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(count_id(D, 0x181), 0, "no process data on a line that cannot send");
+	zassert_equal(count_id(R, 0x181), 1);
+	run_until(t.now + 120 * MS);
+	zassert_true(count_id(D, 0x701) >= 2, "the heartbeat still goes there");
+	co_line_inject_event(&t.line[D], CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(count_id(D, 0x181), 1, "back on both lines");
+	zassert_equal(count_id(R, 0x181), 2);
+}
+
+ZTEST(co_redundancy, test_queued_process_data_withdrawn_when_the_line_goes_error_passive)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	struct co_line_stats before_stats, after_stats;
+
+	rx(D, 0x000, 2, start);
+	t.busy = true;
+	for (int i = 0; i < 3; i++) {
+		(void)co_tpdo_send_req(&t.node, 0);
+	}
+	co_line_get_stats(&t.line[D], &before_stats);
+	co_line_inject_event(&t.line[D], CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
+	co_line_get_stats(&t.line[D], &after_stats);
+	zassert_equal(after_stats.tx_purged - before_stats.tx_purged, 3, "three TPDOs withdrawn");
+	t.busy = false;
+	run_until(t.now + 1 * MS);
+	zassert_equal(count_id(D, 0x181), 0, "none goes out stale");
+	zassert_equal(count_id(R, 0x181), 3);
+}
+
 /* --- 50: SDO server ------------------------------------------------------------------------- */
 
 ZTEST(co_redundancy, test_50_sdo_request_on_the_redundant_line_answered_there_only)
@@ -372,6 +436,24 @@ ZTEST(co_redundancy, test_51_tpdo1_failures_stop_the_heartbeat_good_sends_resume
 	hb = count_id(D, 0x701);
 	run_until(t.now + 200 * MS);
 	zassert_true(count_id(D, 0x701) > hb, "heartbeat resumed");
+}
+
+ZTEST(co_redundancy, test_51_twelve_good_sends_resume_after_any_number_of_failures)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+
+	rx(D, 0x000, 2, start);
+	t.busy = true;
+	for (int i = 0; i < 8 + 40; i++) {
+		(void)co_tpdo_send_req(&t.node, 0);
+	}
+	zassert_not_null(last_rdn(CO_RDN_EV_TPDO_FAILED));
+	t.busy = false;
+	run_until(t.now + 1 * MS);
+	for (int i = 0; i < 12; i++) {
+		zassert_ok(co_tpdo_send_req(&t.node, 0));
+	}
+	zassert_not_null(last_rdn(CO_RDN_EV_TPDO_OK), "the counter stops at the limit");
 }
 
 #else /* CONFIG_CANOPEN_REDUNDANCY_ECSS */
