@@ -149,11 +149,15 @@ struct co_rpdo {
 	bool present;
 	bool sync_pending;
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
-	/* The last frame accepted, to drop its copy from the other line (redundancy). */
-	uint64_t last_at;
-	uint8_t last_data[8];
-	uint8_t last_dlc;
-	uint8_t last_line;
+	/* The last frames taken, to drop their copies from the other line (redundancy). */
+	struct co_rpdo_taken {
+		uint64_t at;
+		uint8_t data[8];
+		uint8_t dlc;
+		uint8_t line;
+		bool copied; /* its copy from the other line came already */
+	} taken[CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH];
+	uint8_t taken_next;
 #endif
 };
 
@@ -209,9 +213,10 @@ struct co_pdo {
 /**
  * @brief RPDO frames dropped as copies from the other line (redundancy, CiA 302-6).
  *
- * A node on two lines hears each PDO twice; the copy that arrives on the other line within
- * CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US with the same data is dropped, so the application
- * sees every value once. Always 0 without CONFIG_CANOPEN_REDUNDANCY.
+ * A node on two lines hears each PDO twice; a frame with the same data as one of the last
+ * CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH frames taken from the other line, within
+ * CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US of it, is that frame's copy and is dropped, so the
+ * application sees every value once. Always 0 without CONFIG_CANOPEN_REDUNDANCY.
  */
 uint32_t co_pdo_rx_duplicates(struct co_node *node);
 

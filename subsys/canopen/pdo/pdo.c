@@ -273,25 +273,38 @@ static void rpdo_mpdo(struct co_rpdo *r, const struct can_frame *frame)
 
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 /*
- * A node on two lines hears a PDO on both: the copy of the frame last taken that comes on the
- * other line within the window is dropped. Frames on the same line are never dropped (a
- * value may repeat), and after a line is lost the other line's frames are taken as they come.
+ * A node on two lines hears a PDO on both. A frame is the copy of one of the last frames taken
+ * from the other line when it has the same data within the window; each taken frame has one
+ * copy. Keeping several (not just the last) lets a line thread that is late by a few frames
+ * catch up without its copies passing as new values. Frames on the same line are never
+ * copies (a value may repeat), and after a line is lost the other line's frames are taken as
+ * they come.
  */
 static bool rpdo_duplicate(struct co_rpdo *r, const struct can_frame *frame, uint64_t now_us)
 {
 	uint8_t line = co_node_rx_line(r->node);
-	uint64_t age = now_us >= r->last_at ? now_us - r->last_at : r->last_at - now_us;
 
-	if (line != r->last_line && frame->dlc == r->last_dlc &&
-	    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
-	    memcmp(frame->data, r->last_data, frame->dlc) == 0) {
-		r->node->pdo.rx_duplicates++;
-		return true;
+	for (uint8_t k = 0; k < ARRAY_SIZE(r->taken); k++) {
+		/* Oldest first: equal values pair with their copies in order. */
+		struct co_rpdo_taken *e = &r->taken[(r->taken_next + k) % ARRAY_SIZE(r->taken)];
+		uint64_t age = now_us >= e->at ? now_us - e->at : e->at - now_us;
+
+		if (!e->copied && e->line != line && e->dlc == frame->dlc && e->dlc != 0xffU &&
+		    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
+		    memcmp(frame->data, e->data, frame->dlc) == 0) {
+			e->copied = true;
+			r->node->pdo.rx_duplicates++;
+			return true;
+		}
 	}
-	r->last_at = now_us;
-	r->last_line = line;
-	r->last_dlc = frame->dlc;
-	memcpy(r->last_data, frame->data, frame->dlc);
+	struct co_rpdo_taken *e = &r->taken[r->taken_next];
+
+	r->taken_next = (uint8_t)((r->taken_next + 1U) % ARRAY_SIZE(r->taken));
+	e->at = now_us;
+	e->line = line;
+	e->dlc = frame->dlc;
+	e->copied = false;
+	memcpy(e->data, frame->data, frame->dlc);
 	return false;
 }
 #endif
@@ -377,6 +390,13 @@ static void rpdo_timeout(struct co_timer *timer, uint64_t now_us)
 static void rpdo_configure(struct co_rpdo *r)
 {
 	struct co_node *node = r->node;
+
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	/* Nothing taken yet: no frame is anybody's copy. */
+	for (uint8_t k = 0; k < ARRAY_SIZE(r->taken); k++) {
+		r->taken[k].dlc = 0xffU;
+	}
+#endif
 
 	co_timer_stop(&r->timer);
 	r->sync_pending = false;

@@ -324,7 +324,7 @@ ZTEST(co_redundancy, test_nmt_from_either_line_and_pdo_copies_delivered_once)
 	rx(R, 0x182, 1, &v);
 	zassert_equal(co_pdo_rx_duplicates(&t.node), 1);
 	/* Its copy on the other line after the window is taken too. */
-	run_until(t.now + 20 * MS);
+	run_until(t.now + CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US + 1000U);
 	rx(D, 0x182, 1, &v);
 	zassert_equal(co_pdo_rx_duplicates(&t.node), 1);
 }
