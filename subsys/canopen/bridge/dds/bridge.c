@@ -688,7 +688,8 @@ static void read_can_state(struct br_line *l)
 	enum can_state cs;
 	struct can_bus_err_cnt cnt = {0};
 
-	if (l->line->dev != NULL && can_get_state(l->line->dev, &cs, &cnt) == 0 &&
+	if (co_line_device(l->line) != NULL &&
+	    can_get_state(co_line_device(l->line), &cs, &cnt) == 0 &&
 	    (l->can_state != (uint8_t)cs || l->tec != cnt.tx_err_cnt || l->rec != cnt.rx_err_cnt)) {
 		l->can_state = (uint8_t)cs;
 		l->tec = cnt.tx_err_cnt;
