@@ -224,8 +224,15 @@ struct co_line_rx_msg {
 
 struct co_line {
 	const char *name;
+#if defined(CONFIG_CANOPEN_LINE_RX_INDEX)
 	/* Receive table: sff[id] is 1 + slot of the first receiver of 11-bit id, 0 for none. */
 	uint8_t sff[CO_LINE_SFF_IDS];
+#else
+	/* Receive table: the ids of the n_slots used slots, ascending (slots[i] is ids[i]'s). */
+	uint16_t slot_ids[CONFIG_CANOPEN_LINE_RX_SLOTS];
+	uint8_t n_slots;
+#endif
+	/* Heads of the chains of receivers of one 11-bit id. */
 	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
 	/* 29-bit and masked receivers, searched in order. */
 	struct co_rx *others;

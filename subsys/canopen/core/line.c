@@ -253,15 +253,139 @@ static void tbl_change_end(struct co_line *line)
 	ST_REL(&line->rx_seq, line->rx_seq + 1U);
 }
 
-static int slot_find_free(struct co_line *line)
+/*
+ * Slots: one per distinct 11-bit id received, each the head of the chain of receivers of that
+ * id. With CONFIG_CANOPEN_LINE_RX_INDEX a 2048-byte index gives the slot of an id at once
+ * (sff[id] = 1 + slot, 0 for none); without it the ids of the used slots are kept ascending
+ * and searched (binary search over CONFIG_CANOPEN_LINE_RX_SLOTS at most). Writers hold the
+ * table lock; readers take none (acquire loads, see above).
+ */
+#if defined(CONFIG_CANOPEN_LINE_RX_INDEX)
+
+static int slot_of(const struct co_line *line, uint32_t id)
+{
+	return (int)line->sff[id] - 1;
+}
+
+static int slot_add(struct co_line *line, uint32_t id, struct co_rx *rx)
 {
 	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
 		if (line->slots[i] == NULL) {
+			ST_REL(&line->slots[i], rx);
+			ST_REL(&line->sff[id], (uint8_t)(i + 1));
 			return i;
 		}
 	}
-	return -1;
+	return -ENOSPC;
 }
+
+/* The chain of slot @p slot (of @p id) has become empty. */
+static void slot_drop(struct co_line *line, uint32_t id, int slot)
+{
+	ARG_UNUSED(slot);
+	ST_REL(&line->sff[id], 0U);
+}
+
+static int slot_count(const struct co_line *line)
+{
+	return CONFIG_CANOPEN_LINE_RX_SLOTS;
+}
+
+static ALWAYS_INLINE struct co_rx *slot_head(const struct co_line *line, uint32_t id)
+{
+	uint8_t slot = LD_ACQ(&line->sff[id]);
+
+	return slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL;
+}
+
+#else /* !CONFIG_CANOPEN_LINE_RX_INDEX */
+
+/* Position of the first used slot whose id is not below @p id (writers). */
+static int slot_pos(const struct co_line *line, uint32_t id)
+{
+	int lo = 0;
+	int hi = line->n_slots;
+
+	while (lo < hi) {
+		int mid = (lo + hi) / 2;
+
+		if (line->slot_ids[mid] < id) {
+			lo = mid + 1;
+		} else {
+			hi = mid;
+		}
+	}
+	return lo;
+}
+
+static int slot_of(const struct co_line *line, uint32_t id)
+{
+	int p = slot_pos(line, id);
+
+	return p < line->n_slots && line->slot_ids[p] == id ? p : -1;
+}
+
+static int slot_add(struct co_line *line, uint32_t id, struct co_rx *rx)
+{
+	int n = line->n_slots;
+	int p = slot_pos(line, id);
+
+	if (n >= CONFIG_CANOPEN_LINE_RX_SLOTS) {
+		return -ENOSPC;
+	}
+	for (int i = n; i > p; i--) {
+		ST_REL(&line->slot_ids[i], line->slot_ids[i - 1]);
+		ST_REL(&line->slots[i], line->slots[i - 1]);
+	}
+	ST_REL(&line->slot_ids[p], (uint16_t)id);
+	ST_REL(&line->slots[p], rx);
+	ST_REL(&line->n_slots, (uint8_t)(n + 1));
+	return p;
+}
+
+static void slot_drop(struct co_line *line, uint32_t id, int slot)
+{
+	int n = line->n_slots;
+
+	ARG_UNUSED(id);
+	for (int i = slot; i + 1 < n; i++) {
+		ST_REL(&line->slot_ids[i], line->slot_ids[i + 1]);
+		ST_REL(&line->slots[i], line->slots[i + 1]);
+	}
+	ST_REL(&line->slots[n - 1], NULL);
+	ST_REL(&line->n_slots, (uint8_t)(n - 1));
+}
+
+static int slot_count(const struct co_line *line)
+{
+	return line->n_slots;
+}
+
+/* Readers: a binary search over a snapshot of the count, every index within the arrays. */
+static ALWAYS_INLINE struct co_rx *slot_head(const struct co_line *line, uint32_t id)
+{
+	int n = LD_ACQ(&line->n_slots);
+	int lo = 0;
+	int hi;
+
+	if (n > CONFIG_CANOPEN_LINE_RX_SLOTS) {
+		n = CONFIG_CANOPEN_LINE_RX_SLOTS;
+	}
+	hi = n;
+
+	while (lo < hi) {
+		int mid = (lo + hi) / 2;
+
+		if (LD_ACQ(&line->slot_ids[mid]) < id) {
+			lo = mid + 1;
+		} else {
+			hi = mid;
+		}
+	}
+	return lo < n && LD_ACQ(&line->slot_ids[lo]) == id ? LD_ACQ(&line->slots[lo]) : NULL;
+}
+
+#endif /* CONFIG_CANOPEN_LINE_RX_INDEX */
 
 /*
  * rx->line changes under the table lock but is read without it: by the dispatcher, which has
@@ -284,19 +408,15 @@ static int rx_link(struct co_line *line, struct co_rx *rx)
 	ST_REL(&rx->next, NULL);
 	if (rx_is_direct(rx)) {
 		uint32_t id = rx->id & SFF_MASK;
-		uint8_t slot = line->sff[id];
+		int slot = slot_of(line, id);
 
-		if (slot == 0U) {
-			int free = slot_find_free(line);
-
-			if (free < 0) {
+		if (slot < 0) {
+			if (slot_add(line, id, rx) < 0) {
 				return -ENOSPC;
 			}
-			ST_REL(&line->slots[free], rx);
-			ST_REL(&line->sff[id], (uint8_t)(free + 1));
 		} else {
 			/* Append, so receivers of one id see frames in registration order. */
-			struct co_rx *tail = line->slots[slot - 1U];
+			struct co_rx *tail = line->slots[slot];
 
 			while (tail->next != NULL) {
 				tail = tail->next;
@@ -324,20 +444,20 @@ static void rx_unlink(struct co_line *line, struct co_rx *rx)
 
 	if (rx_is_direct(rx)) {
 		uint32_t id = rx->id & SFF_MASK;
-		uint8_t slot = line->sff[id];
+		int slot = slot_of(line, id);
 
-		if (slot == 0U) {
+		if (slot < 0) {
 			return;
 		}
-		pp = &line->slots[slot - 1U];
+		pp = &line->slots[slot];
 		while (*pp != NULL && *pp != rx) {
 			pp = &(*pp)->next;
 		}
 		if (*pp == rx) {
 			ST_REL(pp, rx->next);
 		}
-		if (line->slots[slot - 1U] == NULL) {
-			ST_REL(&line->sff[id], 0U);
+		if (line->slots[slot] == NULL) {
+			slot_drop(line, id, slot);
 		}
 	} else {
 		pp = &line->others;
@@ -458,9 +578,7 @@ static ALWAYS_INLINE int rx_collect(const struct co_line *line, const struct can
 	int m = 0;
 
 	if (!ext) {
-		uint8_t slot = LD_ACQ(&line->sff[frame->id & SFF_MASK]);
-
-		for (rx = slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL; rx != NULL;
+		for (rx = slot_head(line, frame->id & SFF_MASK); rx != NULL;
 		     rx = LD_ACQ(&rx->next)) {
 			if (--budget < 0) {
 				return -1;
@@ -541,8 +659,7 @@ int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now
 	uint32_t seq = LD_ACQ(&line->rx_seq);
 
 	if (likely((frame->flags & CAN_FRAME_IDE) == 0U && (seq & 1U) == 0U)) {
-		uint8_t slot = LD_ACQ(&line->sff[frame->id & SFF_MASK]);
-		struct co_rx *rx = slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL;
+		struct co_rx *rx = slot_head(line, frame->id & SFF_MASK);
 
 		if (rx != NULL && LD_ACQ(&rx->next) == NULL && LD_ACQ(&line->others) == NULL &&
 		    LD_ACQ(&line->rx_seq) == seq) {
@@ -942,8 +1059,11 @@ void co_line_attach(struct co_line *line, struct co_line_member *m, const struct
 /* Drop every receiver and timer of one owner (a node leaving the line). */
 static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 {
-	/* The used slots hold every exact 11-bit receiver; rx_unlink() frees emptied ones. */
-	for (unsigned int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
+	/*
+	 * The used slots hold every exact 11-bit receiver; rx_unlink() frees emptied ones (and
+	 * without the index moves the slots above down: hence from the top).
+	 */
+	for (int i = slot_count(line) - 1; i >= 0; i--) {
 		for (struct co_rx *rx = line->slots[i], *next; rx != NULL; rx = next) {
 			next = rx->next;
 			if (rx->lock == lock) {

@@ -175,6 +175,61 @@ ZTEST(co_line, test_unregister_stops_delivery_and_frees_the_slot)
 	zassert_equal(st.rx_unhandled, 1);
 }
 
+/*
+ * Ids registered in any order, some removed from the middle and moved: each frame reaches the
+ * receivers of its id and no other (with or without CONFIG_CANOPEN_LINE_RX_INDEX, which keeps
+ * the used ids sorted and searches them).
+ */
+#define SPREAD_N MIN(24, CONFIG_CANOPEN_LINE_RX_SLOTS)
+
+static uint32_t spread_id(int i)
+{
+	/* Distinct ids over the whole 11-bit range, not in order. */
+	return (uint32_t)((i * 1103U + 17U) % 0x7ffU);
+}
+
+ZTEST(co_line, test_ids_in_any_order_are_found)
+{
+	static struct co_rx rx[SPREAD_N];
+
+	for (int i = 0; i < SPREAD_N; i++) {
+		rx_fill(&rx[i], spread_id(i), 0x7ff, false, i);
+		zassert_ok(co_rx_register(&fx.line, &rx[i]));
+	}
+	for (int i = 0; i < SPREAD_N; i++) {
+		struct can_frame f = std_frame(spread_id(i), 0);
+
+		fx.log_len = 0;
+		zassert_equal(co_line_rx(&fx.line, &f, 0), 1, "id %03x", spread_id(i));
+		zassert_equal(fx.log[0], i);
+	}
+	/* Every third one leaves, every third one moves to an id nobody had. */
+	for (int i = 0; i < SPREAD_N; i += 3) {
+		co_rx_unregister(&rx[i]);
+		zassert_ok(co_rx_set_id(&fx.line, &rx[i + 1], 0x7ff - (uint32_t)i));
+	}
+	for (int i = 0; i < SPREAD_N; i++) {
+		struct can_frame f = std_frame(spread_id(i), 0);
+		bool gone = i % 3 == 0 || i % 3 == 1;
+
+		fx.log_len = 0;
+		zassert_equal(co_line_rx(&fx.line, &f, 0), gone ? 0 : 1, "id %03x", spread_id(i));
+		if (i % 3 == 1) {
+			f = std_frame(0x7ff - (uint32_t)(i - 1), 0);
+			zassert_equal(co_line_rx(&fx.line, &f, 0), 1);
+			zassert_equal(fx.log[0], i, "moved");
+		}
+	}
+	for (int i = 0; i < SPREAD_N; i++) {
+		co_rx_unregister(&rx[i]);
+	}
+	for (int i = 0; i < SPREAD_N; i++) {
+		struct can_frame f = std_frame(spread_id(i), 0);
+
+		zassert_equal(co_line_rx(&fx.line, &f, 0), 0);
+	}
+}
+
 ZTEST(co_line, test_register_checks_ids_and_double_registration)
 {
 	struct co_rx a, b;
