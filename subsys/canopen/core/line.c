@@ -28,6 +28,13 @@
 
 LOG_MODULE_REGISTER(co_line, CONFIG_CANOPEN_LOG_LEVEL);
 
+/* Inlined on the hot paths when optimising for speed; one copy in a size build (-Os). */
+#if defined(__OPTIMIZE_SIZE__)
+#define CO_HOT_INLINE inline
+#else
+#define CO_HOT_INLINE ALWAYS_INLINE
+#endif
+
 #define SFF_MASK 0x7ffU
 #define EFF_MASK 0x1fffffffU
 
@@ -569,7 +576,7 @@ static inline bool rx_selected(const struct co_rx *rx, const struct k_mutex *loc
  * CONFIG_CANOPEN_LINE_RX_FANOUT of them). Returns how many matched, or -1 when the walk took
  * more than @p budget steps (a lookup racing changes; done again under the lock).
  */
-static ALWAYS_INLINE int rx_collect(const struct co_line *line, const struct can_frame *frame,
+static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can_frame *frame,
 				    const struct k_mutex *lock, bool only, struct co_rx **batch,
 				    int budget)
 {
@@ -981,7 +988,7 @@ static __attribute__((noinline)) int line_send_slow(struct co_line *line,
  * so this one queues behind it; a queued frame is drained before tx_count drops to zero.
  * Only sends that overlap in time may go out in either order, as they would on a bus.
  */
-static ALWAYS_INLINE int line_send(struct co_line *line, const struct can_frame *frame,
+static CO_HOT_INLINE int line_send(struct co_line *line, const struct can_frame *frame,
 				   const struct k_mutex *origin)
 {
 	int err = 1;

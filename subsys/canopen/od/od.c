@@ -18,6 +18,13 @@
 
 #define OD_UNLIKELY(x) __builtin_expect(!!(x), 0)
 
+/* Inlined on the hot paths when optimising for speed; one copy in a size build (-Os). */
+#if defined(__OPTIMIZE_SIZE__)
+#define OD_HOT_INLINE inline
+#else
+#define OD_HOT_INLINE inline __attribute__((always_inline))
+#endif
+
 /* ---------------------------------------------------------------------------------------- */
 /* Data types */
 
@@ -1251,8 +1258,8 @@ static inline bool pdo_or_srdo(enum co_od_writer w)
  * coverage test. A hook that changes the table hands the rest of the pass to notify_from(),
  * which goes on exactly as run_notify_at() would have.
  */
-static inline __attribute__((always_inline)) void
-run_notify_cover(struct co_od *od, const struct co_od_req *req, const struct co_od_cover *cover)
+static OD_HOT_INLINE void run_notify_cover(struct co_od *od, const struct co_od_req *req,
+					   const struct co_od_cover *cover)
 {
 	uint32_t gen = od->hook_gen;
 	uint32_t limit = od->hook_next_seq;

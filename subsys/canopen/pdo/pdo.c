@@ -417,7 +417,7 @@ static void rpdo_configure(struct co_rpdo *r)
 
 /* --- TPDO --------------------------------------------------------------------------------- */
 
-static ALWAYS_INLINE void tpdo_sample_now(struct co_tpdo *t)
+static CO_HOT_INLINE void tpdo_sample_now(struct co_tpdo *t)
 {
 	struct co_pdo *pdo = &t->node->pdo;
 

@@ -20,6 +20,13 @@
 #include <canopen/od.h>
 #include <canopen/pdo.h>
 
+/* Inlined on the hot paths when optimising for speed; one copy in a size build (-Os). */
+#if defined(__OPTIMIZE_SIZE__)
+#define CO_HOT_INLINE inline
+#else
+#define CO_HOT_INLINE ALWAYS_INLINE
+#endif
+
 /* Largest data field of a classic CAN frame, in bits. */
 #define CO_PDO_MAX_BITS 64U
 
@@ -80,7 +87,7 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 /* Sample every mapped object into data[8] (zero above the mapped bits); returns the frame
  * length in bytes. A refused read leaves zeros.
  */
-static ALWAYS_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
+static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
 					     uint8_t data[8])
 {
 	if (likely(map->fast_gen == od->hook_gen)) {
@@ -103,7 +110,7 @@ static ALWAYS_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_p
  * Write every mapped object from data (at least the mapped bytes long); dummies are skipped.
  * Returns the number of objects whose write was refused.
  */
-static ALWAYS_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map,
+static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map,
 					   const uint8_t *data)
 {
 	uint32_t gen = od->hook_gen;
