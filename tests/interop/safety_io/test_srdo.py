@@ -43,8 +43,13 @@ def test_good_stream_makes_the_srdo_valid(rig):
     assert rig.timing == SAMPLE_TIMING
     rig.recover(settle=0.5)
     # Both channels reached the dictionary: channel B is the complement of channel A.
-    a = rig.node.sdo[0x6000][2].raw
-    b = rig.node.sdo[0x6001][2].raw
+    # The counter moves every 20 ms: two SDO reads may straddle a pair, so read until a
+    # pair's two channels are caught together.
+    for _ in range(10):
+        a = rig.node.sdo[0x6000][2].raw
+        b = rig.node.sdo[0x6001][2].raw
+        if a ^ b == 0xFF:
+            break
     assert a ^ b == 0xFF, (a, b)
     assert rig.node.sdo[0x6000][1].raw == 0 and rig.node.sdo[0x6001][1].raw == 0xFF
     assert rig.node.sdo[0x2000].raw == 1, "the output is on"

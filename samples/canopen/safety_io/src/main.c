@@ -341,7 +341,6 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 		e.srdo = ev->srdo.srdo;
 		e.reason = ev->srdo.reason;
 		e.safe = ev->srdo.safe;
-		/* The event does not tell a deleted SRDO (direction 0) from a valid one. */
 		e.srdo_state = ev->srdo.srdo != 0U ? co_srdo_get_state(node, ev->srdo.srdo, NULL)
 						   : -EINVAL;
 		e.time_us = ev->srdo.time_us;
@@ -351,6 +350,18 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 	e.fault_us = u->fault_us;
 	if (k_msgq_put(&events, &e, K_NO_WAIT) != 0) {
 		atomic_inc(&events_lost);
+	}
+	/* A deleted SRDO reports no events: say so when Operational starts without it. */
+	if (ev->type == CO_EV_NMT_STATE && ev->nmt.to == CO_NMT_OPERATIONAL &&
+	    co_srdo_get_state(node, SRDO_NO, NULL) == CO_SRDO_STATE_DELETED) {
+		e.type = CO_EV_SRDO;
+		e.srdo = SRDO_NO;
+		e.safe = false;
+		e.reason = CO_SRDO_R_NONE;
+		e.srdo_state = CO_SRDO_STATE_DELETED;
+		if (k_msgq_put(&events, &e, K_NO_WAIT) != 0) {
+			atomic_inc(&events_lost);
+		}
 	}
 	return 0;
 }
