@@ -205,7 +205,7 @@ struct co_event {
 		} redundancy;
 		/** CO_EV_SRDO. */
 		struct {
-			/** SRDO number, 1..64. */
+			/** SRDO number, 1..64; 0 for a received GFC (reason CO_SRDO_R_GFC). */
 			uint8_t srdo;
 			/** The SRDO entered (true) or left (false) the safe state. */
 			bool safe;

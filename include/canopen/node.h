@@ -164,9 +164,9 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
  *
  * Call after co_node_init() and before co_node_start(). The node then hears the line's events
  * (CO_EV_LINE with its index), may send on it (CO_ROUTE_REDUNDANT, CO_ROUTE_BOTH) and register
- * receivers on it (co_node_rx_register()). The services of today still receive on the default
- * line only (NMT, error control and the rest); which service listens where on a redundant
- * line is the redundancy service's decision.
+ * receivers on it (co_node_rx_register()). Services register their receivers on the default
+ * line; with the redundancy service (CONFIG_CANOPEN_REDUNDANCY) they hear the redundant line
+ * too, through co_node_dispatch_from(). Without it they hear the default line only.
  *
  * @retval 0 Attached.
  * @retval -EINVAL A NULL argument, or @p idx is not CO_LINE_REDUNDANT.
