@@ -123,6 +123,19 @@ struct co_mgr_boot_error {
 	uint32_t abort_code;
 };
 
+/**
+ * @brief Whether @p e reports a comparison (expected and actual both meaningful).
+ *
+ * True for the letters that compare a value read from the slave with the manager's (C, D, M,
+ * N, O, H) when the value was read (no SDO abort). Otherwise (B, J, E, K, ... or an aborted
+ * upload) only the object and the abort code say what happened.
+ */
+static inline bool co_mgr_error_compared(const struct co_mgr_boot_error *e)
+{
+	return e->abort_code == 0U && (e->status == 'C' || e->status == 'D' || e->status == 'M' ||
+				       e->status == 'N' || e->status == 'O' || e->status == 'H');
+}
+
 /** One line of the boot table (co_mgr_get_boot()). */
 struct co_mgr_boot_info {
 	uint8_t node_id;

@@ -687,11 +687,16 @@ static void boot_end(struct co_mgr_slave *s)
 	publish(s);
 	if (s->status == CO_MGR_ST_OK) {
 		LOG_INF("%s: node %u booted", m->node->name, s->id);
-	} else {
+	} else if (co_mgr_error_compared(&s->err)) {
 		LOG_WRN("%s: boot of node %u: status %c in %s, object %04Xh:%02Xh expected %08Xh "
-			"actual %08Xh abort %08Xh",
+			"actual %08Xh",
 			m->node->name, s->id, s->status, co_mgr_step_str(s->err.step), s->err.index,
-			s->err.sub, s->err.expected, s->err.actual, s->err.abort_code);
+			s->err.sub, s->err.expected, s->err.actual);
+	} else {
+		/* Nothing was compared: the object and the abort code say what failed. */
+		LOG_WRN("%s: boot of node %u: status %c in %s, object %04Xh:%02Xh abort %08Xh",
+			m->node->name, s->id, s->status, co_mgr_step_str(s->err.step), s->err.index,
+			s->err.sub, s->err.abort_code);
 	}
 	if (m->boot_ind != NULL) {
 		m->boot_ind(m->node, s->id, s->status, s->status == CO_MGR_ST_OK ? NULL : &s->err,
