@@ -40,6 +40,15 @@ enum co_hb_event {
 	CO_HB_EV_RECOVERED,
 	/** The state in the heartbeat changed. */
 	CO_HB_EV_STATE,
+	/**
+	 * Manager on two lines: the slave's heartbeat stayed away on one line
+	 * (@ref co_event.hb "hb.line") for its consumer time while the other line still brings
+	 * it. Never given to the heartbeat consumer's indication.
+	 */
+	CO_HB_EV_LINE_LOST,
+	/** Manager on two lines: the slave's heartbeat is back on a line after CO_HB_EV_LINE_LOST.
+	 */
+	CO_HB_EV_LINE_FOUND,
 };
 
 /**

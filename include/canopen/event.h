@@ -63,7 +63,10 @@ enum co_event_type {
 	 * before Stopped forbids SDO. Raised for every change, the resets' Initialising included.
 	 */
 	CO_EV_NMT_LEAVE,
-	/** The heartbeat consumer saw something of a remote node (@ref co_event.hb). */
+	/**
+	 * The heartbeat consumer saw something of a remote node, or the manager lost or found a
+	 * slave on one of two lines (@ref co_event.hb).
+	 */
 	CO_EV_HB,
 	/** Life guarding of this node was lost or resumed (@ref co_event.life). */
 	CO_EV_LIFE,
@@ -133,6 +136,11 @@ struct co_event {
 			uint8_t node_id;
 			enum co_hb_event event;
 			enum co_nmt_state state;
+			/**
+			 * CO_HB_EV_LINE_LOST, CO_HB_EV_LINE_FOUND: the line concerned
+			 * (enum co_node_line_id); 0 for the other events.
+			 */
+			uint8_t line;
 		} hb;
 		/** CO_EV_LIFE. */
 		struct {

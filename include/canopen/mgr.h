@@ -280,6 +280,10 @@ struct co_mgr_slave {
 	bool cfg_wait;       /* DOWNLOAD step waiting for a configuration job slot */
 	bool await_bootup;   /* reset by the master, no boot-up seen since */
 	bool held;           /* an attempt waits for the master to leave Stopped */
+	/* Two lines: BIT(line) whose loss was reported (CO_HB_EV_LINE_LOST). */
+	uint8_t line_lost;
+	/* Two lines: the last heartbeat on each, or the start of monitoring. */
+	uint64_t line_hb_us[2];
 };
 
 struct co_mgr_nmt_cmd {

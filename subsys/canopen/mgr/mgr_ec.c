@@ -9,6 +9,11 @@
  * replies of every slave. The manager times heartbeats itself (from 1016h) because CiA 302-2
  * §4.1 starts the timeout at once, not at the first heartbeat as the CiA 301 consumer does.
  * Node guarding runs from 1F81h's guard time and retry factor (or a 1F83h request).
+ *
+ * On two lines (the redundancy service hands the redundant line's frames over) each slave's
+ * heartbeat is also followed per line: a line where it stayed away for its consumer time is
+ * reported (CO_HB_EV_LINE_LOST, naming the line) when the other line's next heartbeat shows
+ * the slave alive, so a slave that died on both lines gives only the usual loss.
  */
 
 #include <zephyr/kernel.h>
@@ -73,6 +78,9 @@ void co_mgr_guard_start(struct co_mgr_slave *s, uint16_t gt_ms, uint8_t rf)
 
 void co_mgr_hb_start(struct co_mgr_slave *s, uint64_t now)
 {
+	/* Both lines supervised from now on (302-2 §4.1); a reported loss stays reported. */
+	s->line_hb_us[CO_LINE_DEFAULT] = now;
+	s->line_hb_us[CO_LINE_REDUNDANT] = now;
 	s->hb_on = true;
 	s->ec_lost = false;
 	co_node_timer_start(s->mgr->node, &s->ec_timer, now + MS_US(s->hb_ms));
@@ -158,6 +166,45 @@ void co_mgr_ec_timer_handler(struct co_timer *timer, uint64_t now_us)
 	co_node_timer_start(s->mgr->node, &s->ec_timer, now_us + MS_US(s->guard_ms));
 }
 
+static void line_event(struct co_mgr_slave *s, uint8_t line, enum co_hb_event what)
+{
+	struct co_event ev = {
+		.type = CO_EV_HB,
+		.hb = {.node_id = s->id,
+		       .event = what,
+		       .state = (enum co_nmt_state)s->rep_state,
+		       .line = line},
+	};
+
+	LOG_WRN("%s: node %u heartbeat %s on line %u", s->mgr->node->name, s->id,
+		what == CO_HB_EV_LINE_LOST ? "lost" : "back", line);
+	(void)co_node_publish(s->mgr->node, &ev, NULL);
+}
+
+/* A heartbeat of a monitored slave on line co_node_rx_line(): follow both lines. */
+static void line_hb(struct co_mgr_slave *s, uint64_t now_us)
+{
+	struct co_node *node = s->mgr->node;
+	uint8_t l = co_node_rx_line(node);
+	uint8_t o = l == CO_LINE_DEFAULT ? CO_LINE_REDUNDANT : CO_LINE_DEFAULT;
+
+	if (!IS_ENABLED(CONFIG_CANOPEN_REDUNDANCY) || node->lines[CO_LINE_REDUNDANT].line == NULL ||
+	    l >= CO_NODE_LINES) {
+		return;
+	}
+	s->line_hb_us[l] = now_us;
+	if ((s->line_lost & BIT(l)) != 0U) {
+		s->line_lost &= (uint8_t)~BIT(l);
+		line_event(s, l, CO_HB_EV_LINE_FOUND);
+	}
+	/* Silent there for longer than the consumer time, alive here: lost on that line. */
+	if ((s->line_lost & BIT(o)) == 0U &&
+	    !co_time_before_eq(now_us, s->line_hb_us[o] + MS_US(s->hb_ms))) {
+		s->line_lost |= (uint8_t)BIT(o);
+		line_event(s, o, CO_HB_EV_LINE_LOST);
+	}
+}
+
 /* 302-2 §4 boot-up handler. */
 static void bootup_handler(struct co_mgr *m, uint8_t id, struct co_mgr_slave *s)
 {
@@ -238,6 +285,9 @@ void co_mgr_ec_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	} else if (s->ec_lost && s->hb_ms != 0U && !s->booting) {
 		/* Heartbeat back after a loss: monitor again. */
 		co_mgr_hb_start(s, now_us);
+	}
+	if (s->hb_on) {
+		line_hb(s, now_us);
 	}
 	if (state != s->nmt_state) {
 		co_mgr_set_nmt_view(s, state);

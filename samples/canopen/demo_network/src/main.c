@@ -72,6 +72,9 @@ static void hb_ind(struct co_node *node, uint8_t id, enum co_hb_event ev, enum c
 	case CO_HB_EV_RECOVERED:
 		printk("monitor: node %u heartbeat recovered (%s)\n", id, co_nmt_state_str(st));
 		break;
+	default:
+		/* The per-line events come from a manager on two lines, never from here. */
+		return;
 	}
 	seen.state[id] = ev == CO_HB_EV_BOOTUP ? CO_NMT_INITIALISING : st;
 	seen.alive[id] = ev != CO_HB_EV_LOST;
