@@ -4,22 +4,27 @@
  */
 
 /*
- * manager: a CiA 302 manager (node 1) boots a network of hello_node slaves.
+ * manager: a CiA 302 manager boots the network its DCF describes.
  *
- * The manager's dictionary (objdict/manager.dcf) is the network description: slaves 2..5
- * assigned in 1F81h (2 and 3 mandatory), their expected identity in 1F85h-1F87h, the boot
- * time 1F89h, heartbeat consumer entries in 1016h and the expected configuration date/time
- * 1F26h/1F27h. Each slave gets the concise DCF generated from objdict/slave.dcf (heartbeat
- * 100 ms, setpoint 500, 1020h). Node 5 is expected with another product code than the one
- * hello_node reports, so its boot ends with error M and the sample shows the error report.
+ * The network comes from a DCF read at run time (--dcf FILE, default the bundled
+ * objdict/manager.dcf; src/network.c): the manager's node-ID ([DeviceComissioning] NodeID),
+ * the slaves assigned in 1F81h, their expected identity in 1F84h-1F88h, the boot time 1F89h,
+ * heartbeat consumer entries in 1016h, 1F26h/1F27h, and each slave's concise DCF, the file its
+ * 1F22h sub-index names. Its values are written into the manager's dictionary at every Reset
+ * Communication, as stored parameters would be. The bundled network: hello_node slaves 2..5
+ * (2 and 3 mandatory), each configured by slave.bin (scripts/dcf2cdcf of objdict/slave.dcf:
+ * heartbeat 100 ms, setpoint 500, 1020h); node 5 is expected with another product code than
+ * the one hello_node reports, so its boot ends with error M and the sample shows the report.
  *
- * By default the slaves run in this process, each on its own line thread: the manager on line
- * 0, slave n on line n-1 (can_virtual0..4, one virtual bus; or SocketCAN with --can-if).
- * --slaves=0 runs the manager alone, for slaves in other processes.
+ * By default hello_node slaves run in this process for the first assigned node-IDs (at most
+ * four), each on its own line thread: the manager on line 0, the i-th slave on line i
+ * (can_virtual0..4, one virtual bus; or SocketCAN with --can-if). --slaves=0 runs the manager
+ * alone, for slaves in other processes.
  *
- * Output: a boot table when the NMT startup finishes, then one line per NMT or heartbeat
- * event. Events reach the main thread through a message queue, so nothing is printed from a
- * line thread with a node lock held.
+ * Output: one line per event as it happens (boot-ups, boot results, reported NMT states,
+ * heartbeat losses), also during the boot, and the boot table when the NMT startup finishes.
+ * Events reach the main thread through a message queue, so nothing is printed from a line
+ * thread with a node lock held.
  *
  * --dds starts the Cyclone DDS bridge (doc/dds-bridge.md) on the manager's line: a second
  * terminal watches the network with scripts/safeline-dds watch.
@@ -43,23 +48,25 @@
 #include "cmdline.h"
 #include "hello_node_od.h"
 #include "manager_od.h"
+#include "network.h"
 #include "posix_native_task.h"
 #include "sample_common.h"
-#include "slave_cdcf.h"
 
 LOG_MODULE_REGISTER(manager, LOG_LEVEL_INF);
 
-#define MANAGER_ID  1U
-#define FIRST_SLAVE 2U
-#define MAX_SLAVES  4U
+#define MANAGER_ID 1U
+#define MAX_SLAVES 4U
+/* Options not given. */
+#define NOT_GIVEN  UINT32_MAX
 
 /*
  * The options, with their defaults. Each value is checked while the command line is parsed,
  * so that a bad one ends the process (usage, error, exit code 1) before the boot.
  */
-static unsigned int slaves_arg = MAX_SLAVES;
-static unsigned int cycle_arg = 4U;
-static unsigned int cut_arg = 3U;
+static uint32_t slaves_arg = NOT_GIVEN;
+static uint32_t cycle_arg = NOT_GIVEN;
+static uint32_t cut_arg = NOT_GIVEN;
+static char *dcf_arg;
 static bool dds_arg;
 static char *dds_config_arg;
 static char *dds_allow_arg;
@@ -67,17 +74,17 @@ static uint32_t dds_domain_arg = CO_BRIDGE_DDS_DOMAIN_DEFAULT;
 
 static void slaves_found(char *argv, int offset)
 {
-	slaves_arg = (unsigned int)cmd_read_uint_option("slaves", &argv[offset], 0U, MAX_SLAVES);
+	slaves_arg = (uint32_t)cmd_read_uint_option("slaves", &argv[offset], 0U, MAX_SLAVES);
 }
 
 static void cycle_found(char *argv, int offset)
 {
-	cycle_arg = (unsigned int)cmd_read_uint_option("cycle", &argv[offset], 0U, 127U);
+	cycle_arg = (uint32_t)cmd_read_uint_option("cycle", &argv[offset], 0U, 127U);
 }
 
 static void cut_found(char *argv, int offset)
 {
-	cut_arg = (unsigned int)cmd_read_uint_option("cut", &argv[offset], 0U, 127U);
+	cut_arg = (uint32_t)cmd_read_uint_option("cut", &argv[offset], 0U, 127U);
 }
 
 static void dds_found(char *argv, int offset)
@@ -94,12 +101,23 @@ static void add_options(void)
 {
 	static struct args_struct_t opts[] = {
 		{
+			.option = "dcf",
+			.name = "file",
+			.type = 's',
+			.dest = &dcf_arg,
+			.descript = "the network: the manager's DCF (1F81h slaves, 1F84h-1F89h, "
+				    "1016h, 1F22h UploadFile= concise DCF per slave; default the "
+				    "bundled objdict/manager.dcf)",
+		},
+		{
 			.option = "slaves",
 			.name = "0..4",
 			.type = 'u',
 			.call_when_found = slaves_found,
-			.descript = "hello_node slaves run in this process (nodes 2.., lines 1..; "
-				    "default 4, 0 = the manager alone)",
+			.descript =
+				"hello_node slaves run in this process for the first node-IDs "
+				"the DCF assigns (lines 1..; default all of them, at most 4; 0 = "
+				"the manager alone)",
 		},
 		{
 			.option = "cycle",
@@ -107,15 +125,16 @@ static void add_options(void)
 			.type = 'u',
 			.call_when_found = cycle_found,
 			.descript = "power-cycle this in-process slave 1 s after the startup "
-				    "(default 4, 0 = none)",
+				    "(default the third in-process slave, 0 = none)",
 		},
 		{
 			.option = "cut",
 			.name = "node",
 			.type = 'u',
 			.call_when_found = cut_found,
-			.descript = "cut this in-process slave off the virtual bus 2 s after the "
-				    "startup, for 1 s (default 3, 0 = none)",
+			.descript =
+				"cut this in-process slave off the virtual bus 2 s after the "
+				"startup, for 1 s (default the second in-process slave, 0 = none)",
 		},
 		{
 			.is_switch = true,
@@ -157,18 +176,116 @@ static void add_options(void)
 }
 NATIVE_TASK(add_options, PRE_BOOT_1, 21);
 
-/* Once the whole command line is parsed, still before the boot. */
+/* The network (--dcf), the manager's node-ID and the in-process slaves, settled before boot. */
+static struct network net;
+static uint8_t manager_id;
+static unsigned int n_slaves;
+static unsigned int cycle_node;
+static unsigned int cut_node;
+
+static bool is_slave(uint32_t id)
+{
+	for (unsigned int i = 0; i < net.n_slaves; i++) {
+		if (net.slaves[i] == id) {
+			return true;
+		}
+	}
+	return false;
+}
+
+static bool in_process(uint32_t id)
+{
+	for (unsigned int i = 0; i < n_slaves; i++) {
+		if (net.slaves[i] == id) {
+			return true;
+		}
+	}
+	return false;
+}
+
+/* "2, 3, 4, 5": the slaves from the @p first-th on */
+static void slave_list(char *buf, size_t len, unsigned int first)
+{
+	size_t n = 0;
+
+	buf[0] = '\0';
+	for (unsigned int i = first; i < net.n_slaves && n < len; i++) {
+		int k = snprintf(buf + n, len - n, "%s%u", i == first ? "" : ", ", net.slaves[i]);
+
+		n += k > 0 ? (size_t)k : 0U;
+	}
+}
+
+static unsigned int demo_node(uint32_t arg, const char *option, unsigned int dflt_index)
+{
+	char value[16];
+
+	if (arg == NOT_GIVEN) {
+		return dflt_index < n_slaves ? net.slaves[dflt_index] : 0U;
+	}
+	if (arg != 0U && !in_process(arg)) {
+		(void)snprintf(value, sizeof(value), "%u", arg);
+		cmd_option_error(option, value, "not a slave of this process (--slaves, --dcf)");
+	}
+	return arg;
+}
+
+/*
+ * Once the whole command line is parsed, still before the boot: read the DCF and try its
+ * values on a scratch copy of the manager's dictionary, so a file the manager cannot serve
+ * ends the process with the reason, not the boot.
+ */
 static void check_options(void)
 {
-	int id = sample_node_id(MANAGER_ID);
-	char value[8];
+	static struct manager_od_ram scratch_ram;
+	static struct co_od scratch;
+	const char *path = dcf_arg != NULL ? dcf_arg : MANAGER_DCF;
+	const struct network_value *bad;
+	char err[512], list[400];
+	uint32_t ab;
+	int id;
 
-	if (id >= (int)FIRST_SLAVE && id < (int)(FIRST_SLAVE + MAX_SLAVES)) {
-		(void)snprintf(value, sizeof(value), "%d", id);
-		cmd_option_error("node-id", value,
-				 "%u..%u are the slaves of the network description", FIRST_SLAVE,
-				 FIRST_SLAVE + MAX_SLAVES - 1U);
+	if (network_load(&net, path, err, sizeof(err)) != 0) {
+		cmd_option_error("dcf", path, "%s", err);
 	}
+	id = sample_node_id(net.node_id != 0U ? net.node_id : MANAGER_ID);
+	manager_id = (uint8_t)id;
+	slave_list(list, sizeof(list), 0U);
+	if (is_slave(manager_id)) {
+		(void)snprintf(err, sizeof(err), "%d", id);
+		cmd_option_error(sample_node_id(0) != 0 ? "node-id" : "dcf",
+				 sample_node_id(0) != 0 ? err : path,
+				 "node %d is a slave of the network (1F81h assigns %s)", id, list);
+	}
+	if (net.n_slaves > CONFIG_CANOPEN_MGR_SLAVES) {
+		cmd_option_error("dcf", path,
+				 "1F81h assigns %u slaves (%s); the manager has %d slave slots "
+				 "(CONFIG_CANOPEN_MGR_SLAVES)",
+				 net.n_slaves, list, CONFIG_CANOPEN_MGR_SLAVES);
+	}
+	if (co_od_init(&scratch, &manager_od_def, &scratch_ram, manager_id) != 0) {
+		cmd_option_error("dcf", path, "the manager's dictionary cannot be set up");
+	}
+	co_od_reset_app(&scratch);
+	co_od_reset_comm(&scratch);
+	ab = network_apply(&net, &scratch, &bad);
+	if (ab != 0U) {
+		cmd_option_error("dcf", path,
+				 "%s:%u: %04Xh:%02X = 0x%08X: refused by the manager's "
+				 "dictionary (SDO abort %08X)",
+				 path, bad->line, bad->index, bad->sub, bad->value, ab);
+	}
+	if (slaves_arg == NOT_GIVEN) {
+		n_slaves = MIN(net.n_slaves, MAX_SLAVES);
+	} else if (slaves_arg > net.n_slaves) {
+		(void)snprintf(err, sizeof(err), "%u", slaves_arg);
+		cmd_option_error("slaves", err, "the network has %u slaves (%s)", net.n_slaves,
+				 list);
+	} else {
+		n_slaves = slaves_arg;
+	}
+	cycle_node = demo_node(cycle_arg, "cycle", 2U);
+	cut_node = demo_node(cut_arg, "cut", 1U);
 }
 NATIVE_TASK(check_options, PRE_BOOT_2, 21);
 
@@ -176,6 +293,8 @@ struct slave {
 	struct co_line line;
 	struct co_node node;
 	struct hello_node_od_ram ram;
+	char line_name[8];
+	char node_name[12];
 };
 
 static struct slave slaves[MAX_SLAVES];
@@ -326,14 +445,21 @@ static void result_str(uint8_t st, char *buf, size_t len)
 	}
 }
 
-/* "status M (product code differs (1F86h)) in PRODUCT: 1018h:02 expected ... actual ..." */
+/*
+ * "product code differs (1F86h), step PRODUCT, 1018h:02 expected ... actual ...": expected and
+ * actual only where the manager compared a value it read; B, J, ... name the object alone.
+ */
 static void error_str(const struct co_mgr_boot_error *e, char *buf, size_t len)
 {
 	int n = snprintf(buf, len, "%s, step %s", status_text(e->status), co_mgr_step_str(e->step));
 
 	if (e->index != 0U && n > 0 && (size_t)n < len) {
-		n += snprintf(buf + n, len - n, ", %04Xh:%02X expected %08X actual %08X", e->index,
-			      e->sub, e->expected, e->actual);
+		if (co_mgr_error_compared(e)) {
+			n += snprintf(buf + n, len - n, ", %04Xh:%02X expected %08X actual %08X",
+				      e->index, e->sub, e->expected, e->actual);
+		} else {
+			n += snprintf(buf + n, len - n, ", %04Xh:%02X", e->index, e->sub);
+		}
 	}
 	if (e->abort_code != 0U && n > 0 && (size_t)n < len) {
 		(void)snprintf(buf + n, len - n, ", SDO abort %08X", e->abort_code);
@@ -471,6 +597,16 @@ static bool on_virtual_bus(const struct device *dev)
 	return strncmp(dev->name, "can_virtual", 11) == 0;
 }
 
+static struct slave *slave_of(unsigned int id)
+{
+	for (unsigned int i = 0; i < n_slaves; i++) {
+		if (net.slaves[i] == id) {
+			return &slaves[i];
+		}
+	}
+	return NULL;
+}
+
 static void demo(enum demo_action a, unsigned int cycle, unsigned int cut, uint64_t start_us)
 {
 	double t = (double)(co_line_time(&mline) - start_us) / 1e6;
@@ -480,7 +616,7 @@ static void demo(enum demo_action a, unsigned int cycle, unsigned int cut, uint6
 		if (cycle != 0U) {
 			/* A slave that loses power and comes back: the boot-up handler boots it. */
 			printk("[%8.3f s] node %3u  power-cycled (local Reset node)\n", t, cycle);
-			(void)co_nmt_req(&slaves[cycle - FIRST_SLAVE].node, CO_NMT_CS_RESET_NODE);
+			(void)co_nmt_req(&slave_of(cycle)->node, CO_NMT_CS_RESET_NODE);
 		}
 		break;
 	case DEMO_CUT:
@@ -490,13 +626,13 @@ static void demo(enum demo_action a, unsigned int cycle, unsigned int cut, uint6
 			 * 4 and 6 clear) and, without a boot-up, boots it again a while later.
 			 */
 			printk("[%8.3f s] node %3u  cut off the bus\n", t, cut);
-			(void)can_virtual_cut(slaves[cut - FIRST_SLAVE].line.dev);
+			(void)can_virtual_cut(slave_of(cut)->line.dev);
 		}
 		break;
 	case DEMO_RESTORE:
 		if (cut != 0U) {
 			printk("[%8.3f s] node %3u  back on the bus\n", t, cut);
-			(void)can_virtual_restore(slaves[cut - FIRST_SLAVE].line.dev);
+			(void)can_virtual_restore(slave_of(cut)->line.dev);
 		}
 		break;
 	default:
@@ -656,18 +792,18 @@ static int start_slave(unsigned int i)
 {
 	struct slave *s = &slaves[i];
 	const struct device *can = sample_line_device(i + 1U);
-	static const char *const names[MAX_SLAVES] = {"line1", "line2", "line3", "line4"};
-	static const char *const node_names[MAX_SLAVES] = {"slave2", "slave3", "slave4", "slave5"};
 	int err;
 
 	if (can == NULL) {
 		LOG_ERR("no CAN controller for line %u", i + 1U);
 		return -ENODEV;
 	}
-	err = co_line_init(&s->line, names[i], can);
+	(void)snprintf(s->line_name, sizeof(s->line_name), "line%u", i + 1U);
+	(void)snprintf(s->node_name, sizeof(s->node_name), "slave%u", net.slaves[i]);
+	err = co_line_init(&s->line, s->line_name, can);
 	if (err == 0) {
-		err = co_node_init(&s->node, node_names[i], &s->line, &hello_node_od_def, &s->ram,
-				   (uint8_t)(FIRST_SLAVE + i));
+		err = co_node_init(&s->node, s->node_name, &s->line, &hello_node_od_def, &s->ram,
+				   net.slaves[i]);
 	}
 	if (err == 0 && dds_arg) {
 		data_providers[i] = (struct co_od_provider){
@@ -689,6 +825,25 @@ static int start_slave(unsigned int i)
 	return err;
 }
 
+/*
+ * The DCF's values go into the manager's dictionary at every Reset Communication, after the
+ * defaults, as stored parameters would (the sample has no storage of its own).
+ */
+static void restore_network(struct co_od *od, uint32_t group_mask, void *user_data)
+{
+	const struct network_value *bad;
+	uint32_t ab;
+
+	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) == 0U) {
+		return;
+	}
+	ab = network_apply(&net, od, &bad);
+	if (ab != 0U) {
+		LOG_ERR("%s:%u: %04Xh:%02X refused (%08X)", net.path, bad->line, bad->index,
+			bad->sub, ab);
+	}
+}
+
 static int start_manager(uint8_t id)
 {
 	const struct device *can = sample_line_device(0);
@@ -705,9 +860,17 @@ static int start_manager(uint8_t id)
 	if (err == 0) {
 		err = co_cfg_init(&cfg, &mgr);
 	}
-	/* Every slave gets the same configuration (1F22h:2..5). */
-	for (uint8_t n = FIRST_SLAVE; err == 0 && n < FIRST_SLAVE + MAX_SLAVES; n++) {
-		err = co_cfg_set_concise_dcf(&cfg, n, slave_cdcf, sizeof(slave_cdcf));
+	/* Each slave's concise DCF: the file its 1F22h sub-index names. */
+	for (unsigned int n = 1; err == 0 && n <= 127U; n++) {
+		if (net.cdcf[n] != NULL) {
+			err = co_cfg_set_concise_dcf(&cfg, (uint8_t)n, net.cdcf[n],
+						     net.cdcf_size[n]);
+		}
+	}
+	if (err == 0) {
+		co_node_lock(&mgr);
+		err = co_od_set_restore_cb(co_node_od(&mgr), restore_network, NULL);
+		co_node_unlock(&mgr);
 	}
 	if (err != 0) {
 		return err;
@@ -732,24 +895,20 @@ static int start_manager(uint8_t id)
 
 int main(void)
 {
-	unsigned int n_slaves = slaves_arg;
-	unsigned int cycle = cycle_arg;
-	unsigned int cut = cut_arg;
+	unsigned int cycle = cycle_node;
+	unsigned int cut = cut_node;
 	unsigned int next = DEMO_COUNT; /* next demo action; DEMO_COUNT: none pending */
 	int64_t done_ms = 0;
-	int id = sample_node_id(MANAGER_ID);
-	bool live = false;
 	uint64_t start_us;
 	struct event ev;
+	char list[400];
 	int err;
 
-	if (cycle != 0U && (cycle < FIRST_SLAVE || cycle >= FIRST_SLAVE + n_slaves)) {
-		cycle = 0U; /* not a slave of this process */
+	if (cut != 0U &&
+	    !on_virtual_bus(sample_line_device((unsigned int)(slave_of(cut) - slaves) + 1U))) {
+		cut = 0U; /* only a slave on the virtual bus can be cut */
 	}
-	if (cut != 0U && (cut < FIRST_SLAVE || cut >= FIRST_SLAVE + n_slaves ||
-			  !on_virtual_bus(sample_line_device(cut - 1U)))) {
-		cut = 0U; /* only an in-process slave on the virtual bus can be cut */
-	}
+	printk("manager: network %s\n", net.path);
 
 	if (dds_arg && dds_start() != 0) {
 		return 1;
@@ -758,17 +917,19 @@ int main(void)
 	for (unsigned int i = 0; i < n_slaves; i++) {
 		err = start_slave(i);
 		if (err != 0) {
-			LOG_ERR("slave %u failed to start (%d)", FIRST_SLAVE + i, err);
+			LOG_ERR("slave %u failed to start (%d)", net.slaves[i], err);
 			return 1;
 		}
-		printk("manager: slave %u (hello_node) on %s\n", FIRST_SLAVE + i,
+		printk("manager: slave %u (hello_node) on %s\n", net.slaves[i],
 		       slaves[i].line.dev->name);
 	}
-	if (n_slaves == 0U) {
-		printk("manager: no slaves in this process; waiting for nodes 2..5 on the bus\n");
+	slave_list(list, sizeof(list), n_slaves);
+	if (n_slaves < net.n_slaves) {
+		printk("manager: %s slaves in this process; waiting for nodes %s on the bus\n",
+		       n_slaves == 0U ? "no" : "not all", list);
 	}
 	start_us = co_line_time(&mline);
-	err = start_manager((uint8_t)id);
+	err = start_manager(manager_id);
 	if (err != 0) {
 		LOG_ERR("manager failed to start (%d)", err);
 		return 1;
@@ -799,14 +960,12 @@ int main(void)
 				       "with %c (%s)\n",
 				       ms, ev.err.node_id, ev.err.status, det);
 			}
-			live = true;
 			done_ms = k_uptime_get();
 			next = 0;
 			continue;
 		}
-		if (live) {
-			print_event(&ev, start_us);
-		}
+		/* Also during the boot: a slave that never reports Operational shows it. */
+		print_event(&ev, start_us);
 		if (atomic_get(&events_lost) != 0) {
 			printk("manager: %ld events lost (queue full)\n",
 			       (long)atomic_set(&events_lost, 0));
