@@ -159,7 +159,7 @@ int cmd_parse_double(const char *str, double min, double max, double *out)
 
 void cmd_option_error(const char *option, const char *str, const char *format, ...)
 {
-	char reason[160];
+	char reason[512]; /* room for a file path and line in the reason */
 	va_list ap;
 
 	va_start(ap, format);

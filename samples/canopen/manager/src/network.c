@@ -256,22 +256,22 @@ static int load_cdcf(struct network *net, const char *dcf_path, uint8_t id, char
 	if (buf == NULL || fread(buf, 1, (size_t)size, f) != (size_t)size) {
 		free(buf);
 		fclose(f);
-		return fail(err, errlen, dcf_path, line, "1F22h:%02X: cannot read %s", id, full);
+		return fail(err, errlen, dcf_path, line, "1F22h:%02X: cannot read %s", id, name);
 	}
 	fclose(f);
 	if (size > 0 && (buf[0] == '[' || buf[0] == ';')) {
 		free(buf);
 		return fail(err, errlen, dcf_path, line,
 			    "1F22h:%02X: %s is a DCF/EDS text; name its concise DCF instead "
-			    "(scripts/dcf2cdcf %s --node-id %u -o NAME.bin)",
-			    id, full, full, id);
+			    "(scripts/dcf2cdcf FILE --node-id %u -o FILE.bin)",
+			    id, name, id);
 	}
 	if (!cdcf_valid(buf, (size_t)size)) {
 		free(buf);
 		return fail(err, errlen, dcf_path, line,
 			    "1F22h:%02X: %s is not a concise DCF (count, entries and length "
 			    "disagree)",
-			    id, full);
+			    id, name);
 	}
 	net->cdcf[id] = buf;
 	net->cdcf_size[id] = (uint32_t)size;

@@ -9,6 +9,7 @@ SAFELINE_HELLO_NODE_IMAGE / SAFELINE_MANAGER_IMAGE when set."""
 import os
 import pathlib
 import socket
+import struct
 import sys
 from unittest import mock
 
@@ -139,3 +140,164 @@ def test_manager_good_options(manager):
     assert result.returncode == 0, result.stderr
     assert "manager: no slaves in this process" in result.stdout
     assert "manager: node 127 on can_virtual0" in result.stdout
+
+
+# --- The manager's network from a DCF (--dcf) ---------------------------------------------------
+
+def _network_dcf(path, node_id=None, slaves=(), mandatory=(), files=None, boot_time=2000,
+                 extra=""):
+    """A manager DCF of the network objects alone: hello_node identities for `slaves`, hex keys
+    in [xxxxValue] for even node-IDs and decimal keys for odd ones (CiA 306 allows both)."""
+    def key(n):
+        return f"0x{n:X}" if n % 2 == 0 else str(n)
+
+    lines = []
+    if node_id is not None:
+        lines += ["[DeviceComissioning]", f"NodeID=0x{node_id:02X}", ""]
+    lines += ["[1F80]", "ParameterValue=0x00000001", "", "[1F89]", f"ParameterValue={boot_time}", ""]
+    for index, value in (("1F81", None), ("1F85", 0x539), ("1F86", 1), ("1F87", 0x10000)):
+        lines += [f"[{index}]", "ObjectType=0x8", "CompactSubObj=127", "DataType=0x0007",
+                  "AccessType=rw", "DefaultValue=0", "", f"[{index}Value]",
+                  f"NrOfEntries={len(slaves)}"]
+        for n in slaves:
+            v = (0x0D if n in mandatory else 0x05) if value is None else value
+            lines.append(f"{key(n)}=0x{v:08X}")
+        lines.append("")
+    lines += ["[1016]", "SubNumber=9", ""]
+    for i, n in enumerate(slaves[:8], 1):
+        lines += [f"[1016sub{i}]", "DataType=0x0007", f"ParameterValue=0x00{n:02X}012C", ""]
+    for n, name in (files or {}).items():
+        lines += [f"[1F22sub{n:X}]", "DataType=0x000F", f"UploadFile={name}", ""]
+    path.write_text(extra + "\n".join(lines) + "\n")
+    return path
+
+
+def _slave_bin(manager):
+    # The bundled concise DCF of hello_node (build/network/slave.bin, next to the image's build).
+    return (manager.parent.parent / "network" / "slave.bin").read_bytes()
+
+
+def test_manager_prints_events_during_the_boot(manager):
+    result = _run(manager, "--stop-at=0.5", "--cycle=0", "--cut=0")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    table = out.index("  node  role ")
+    # The startup's Reset Communication brings a boot-up from every slave before the table.
+    for n in (2, 3, 4, 5):
+        assert f"node {n:3d}  boot-up" in out[:table], out
+    assert "node   5  boot failed: M" in out[:table], out
+
+
+def test_manager_serves_another_network_from_its_dcf(manager, tmp_path):
+    (tmp_path / "hello.bin").write_bytes(_slave_bin(manager))
+    dcf = _network_dcf(tmp_path / "net.dcf", node_id=0x20, slaves=(0x30, 0x31, 0x7F),
+                       mandatory=(0x30,), files={0x30: "hello.bin", 0x31: "hello.bin",
+                                                 0x7F: str(tmp_path / "hello.bin")})
+    result = _run(manager, f"--dcf={dcf}", "--stop-at=1", "--cycle=0", "--cut=0")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    assert "manager: node 32 on can_virtual0" in out, out
+    for n, line in ((48, 1), (49, 2), (127, 3)):
+        assert f"manager: slave {n} (hello_node) on can_virtual{line}" in out, out
+    assert "    48  mandatory  00000539  00000001  00010000  OK " in out, out
+    assert "    49  optional   00000539  00000001  00010000  OK " in out, out
+    assert "   127  optional   00000539  00000001  00010000  OK " in out, out
+    assert "manager: NMT startup DONE" in out
+    # The concise DCF from the named file set the heartbeat to 100 ms: the slaves report
+    # Operational after the start.
+    for n in (48, 49, 127):
+        assert f"node {n:3d}  OPERATIONAL" in out, out
+
+
+def test_manager_waits_for_the_dcf_slaves_it_does_not_run(manager, tmp_path):
+    dcf = _network_dcf(tmp_path / "net.dcf", slaves=(7, 9), boot_time=300)
+    result = _run(manager, f"--dcf={dcf}", "--slaves=1", "--stop-at=0.2")
+    assert result.returncode == 0, result.stderr
+    assert "manager: slave 7 (hello_node) on can_virtual1" in result.stdout
+    assert "waiting for nodes 9 on the bus" in result.stdout, result.stdout
+    assert "2..5" not in result.stdout
+
+
+def test_manager_b_text_names_no_comparison(manager, tmp_path):
+    # Mandatory node 64 is absent: B, and the startup halts after 1F89h = 300 ms.
+    dcf = _network_dcf(tmp_path / "net.dcf", slaves=(64,), mandatory=(64,), boot_time=300)
+    result = _run(manager, f"--dcf={dcf}", "--slaves=0", "--stop-at=1.5")
+    assert result.returncode == 0, result.stderr
+    halted = [l for l in result.stdout.splitlines() if "NMT startup HALTED" in l]
+    assert halted and "node 64 failed with B" in halted[0], result.stdout
+    assert "no answer to the 1000h upload" in result.stdout
+    assert "expected 00000000 actual 00000000" not in result.stdout, result.stdout
+    assert "expected" not in halted[0], halted[0]
+
+
+def test_manager_j_text_names_the_entry_and_the_abort(manager, tmp_path):
+    # A concise DCF that writes an object hello_node does not have: J at that entry.
+    (tmp_path / "bad.bin").write_bytes(struct.pack("<IHBIB", 1, 0x5FFF, 0, 1, 7))
+    dcf = _network_dcf(tmp_path / "net.dcf", slaves=(2,), files={2: "bad.bin"})
+    result = _run(manager, f"--dcf={dcf}", "--stop-at=0.5", "--cycle=0", "--cut=0")
+    assert result.returncode == 0, result.stderr
+    rows = [l for l in result.stdout.splitlines() if l.startswith("     2  ")]
+    assert rows and "  J  " in rows[0], result.stdout
+    assert "step DOWNLOAD, 5FFFh:00, SDO abort 06020000" in rows[0], rows[0]
+    assert "expected" not in rows[0], rows[0]
+
+
+@pytest.mark.parametrize("case", ["missing", "key_outside", "bad_number", "nodeid_formula",
+                                  "text_cdcf", "bad_cdcf", "missing_cdcf", "manager_is_slave",
+                                  "too_many_slaves", "sub_too_high", "value_too_big"])
+def test_manager_refuses_a_dcf_it_cannot_serve(manager, tmp_path, case):
+    (tmp_path / "hello.bin").write_bytes(_slave_bin(manager))
+    path = tmp_path / "net.dcf"
+    expect = {"missing": "cannot open", "key_outside": "net.dcf:1: ",
+              "bad_number": "is not an unsigned 32-bit number",
+              "nodeid_formula": "$NODEID", "text_cdcf": "scripts/dcf2cdcf",
+              "bad_cdcf": "is not a concise DCF", "missing_cdcf": "cannot open",
+              "manager_is_slave": "node 1 is a slave", "too_many_slaves": "slave slots",
+              "sub_too_high": "is not a sub-index 1..127",
+              "value_too_big": "refused by the manager's dictionary"}[case]
+    if case == "missing":
+        path = tmp_path / "nonexistent.dcf"
+    elif case == "key_outside":
+        _network_dcf(path, slaves=(2,), extra="NodeID=3\n")
+    elif case == "bad_number":
+        _network_dcf(path, slaves=(2,), boot_time="5000ms")
+    elif case == "nodeid_formula":
+        _network_dcf(path, slaves=(2,), boot_time="$NODEID+0x100")
+    elif case == "text_cdcf":
+        (tmp_path / "slave.dcf").write_text("[FileInfo]\nFileName=slave.dcf\n")
+        _network_dcf(path, slaves=(2,), files={2: "slave.dcf"})
+    elif case == "bad_cdcf":
+        (tmp_path / "short.bin").write_bytes(struct.pack("<IHBI", 2, 0x1017, 0, 2) + b"\x64\x00")
+        _network_dcf(path, slaves=(2,), files={2: "short.bin"})
+    elif case == "missing_cdcf":
+        _network_dcf(path, slaves=(2,), files={2: "absent.bin"})
+    elif case == "manager_is_slave":
+        _network_dcf(path, slaves=(1, 2))
+    elif case == "too_many_slaves":
+        _network_dcf(path, slaves=tuple(range(2, 12)))
+    elif case == "sub_too_high":
+        _network_dcf(path, slaves=(2,), extra="[1F84]\nCompactSubObj=127\n[1F84Value]\n0x80=1\n")
+    elif case == "value_too_big":
+        # 1F89h is fine, 1016h has 8 entries: a ninth one cannot be written.
+        _network_dcf(path, slaves=(2,), extra="[1016sub9]\nParameterValue=0x0002012C\n")
+    args = (f"--dcf={path}", "--stop-at=2")
+    result = _run(manager, *args)
+    assert_refused(result, "dcf", args)
+    assert expect in result.stderr, result.stderr
+
+
+def test_manager_refuses_a_node_id_of_the_dcf_network(manager, tmp_path):
+    dcf = _network_dcf(tmp_path / "net.dcf", slaves=(0x30,))
+    args = (f"--dcf={dcf}", "--node-id=0x30", "--stop-at=2")
+    result = _run(manager, *args)
+    assert_refused(result, "node-id", args)
+    assert "node 48 is a slave of the network (1F81h assigns 48)" in result.stderr
+
+
+def test_manager_refuses_demo_nodes_not_in_this_process(manager, tmp_path):
+    dcf = _network_dcf(tmp_path / "net.dcf", slaves=(0x30, 0x31))
+    for option in ("cycle", "cut"):
+        args = (f"--dcf={dcf}", f"--{option}=4", "--stop-at=2")
+        assert_refused(_run(manager, *args), option, args)
+    args = (f"--dcf={dcf}", "--slaves=3", "--stop-at=2")
+    assert_refused(_run(manager, *args), "slaves", args)
