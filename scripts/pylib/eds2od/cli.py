@@ -33,6 +33,8 @@ def main(argv=None) -> int:
     ap.add_argument("--lint-only", action="store_true", help="only check the file")
     ap.add_argument("--no-crosscheck", action="store_true",
                     help="do not compare the reading with python-canopen's")
+    ap.add_argument("--strict", action="store_true",
+                    help="treat warnings (what CiA 306 allows but is worth a look) as errors")
     args = ap.parse_args(argv)
 
     name = args.name or os.path.splitext(os.path.basename(args.input))[0]
@@ -40,9 +42,9 @@ def main(argv=None) -> int:
     if not re.match(r"^[a-z_]", name):
         name = "od_" + name
     try:
-        model = load(args.input)
+        model = load(args.input, args.strict)
     except LintError as e:
-        for m in e.messages:
+        for m in e.warnings + e.messages:
             print(m, file=sys.stderr)
         print(f"eds2od: {len(e.messages)} error(s) in {args.input}", file=sys.stderr)
         return 1
@@ -51,10 +53,15 @@ def main(argv=None) -> int:
         return 2
     if not args.no_crosscheck:
         problems = crosscheck(model, args.input)
+        for m in model.warnings:
+            print(m, file=sys.stderr)
         if problems:
             for m in problems:
                 print(m, file=sys.stderr)
             return 1
+    else:
+        for m in model.warnings:
+            print(m, file=sys.stderr)
     if args.lint_only:
         return 0
     if not args.outdir:

@@ -12,7 +12,7 @@ import re
 import struct
 
 from . import dtypes
-from .model import NOT_STORED, Model, Obj, Sub
+from .model import NOT_STORED, Model, Obj, Sub, cident, record_fields
 
 ACCESS_ENUM = {"ro": 0, "wo": 1, "rw": 2, "rwr": 3, "rww": 4, "const": 5}
 GROUP_ENUM = {"none": 0, "comm": 1, "app": 2, "manuf": 3}
@@ -48,11 +48,6 @@ def count_checks(name: str) -> str:
 
 # --------------------------------------------------------------------------------------
 # Layout
-
-
-def cident(name: str) -> str:
-    s = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_").lower()
-    return s or "unnamed"
 
 
 def plan(model: Model):
@@ -101,15 +96,9 @@ def sub_fields(o: Obj):
         for s in o.subs:
             out[s.sub] = ".sub0" if s.sub == 0 else f".elem[{s.sub - 1}]"
         return out
-    used = set()
-    for s in o.subs:
-        n = cident(s.name)
-        if n[0].isdigit():
-            n = f"sub{s.sub}_{n}"
-        if n in used:
-            n = f"{n}_{s.sub}"
-        used.add(n)
-        out[s.sub] = "." + n
+    # The reader refused names that are reserved in C or clash (model.check_identifiers).
+    for sub, (n, _) in record_fields(o).items():
+        out[sub] = "." + n
     return out
 
 

@@ -95,6 +95,19 @@ def expect(tmp_path, text, needle, message, nth=1):
     assert re.search(pat, r.stderr), f"want line {line} '{message}', got:\n{r.stderr}"
 
 
+def expect_warning(tmp_path, text, needle, message, nth=1):
+    """Accepted with `file:line: warning: message`; refused with --strict."""
+    p, r = lint(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    line = line_of(text, needle, nth)
+    pat = re.escape(f"{p}:{line}: warning: ") + r".*" + re.escape(message)
+    assert re.search(pat, r.stderr), f"want line {line} '{message}', got:\n{r.stderr}"
+    r = run_eds2od(p, extra=["--strict"])
+    assert r.returncode == 1, r.stderr
+    pat = re.escape(f"{p}:{line}: ") + r".*" + re.escape(message) + r".*\(--strict\)"
+    assert re.search(pat, r.stderr), f"want line {line} '{message}', got:\n{r.stderr}"
+
+
 def test_valid_file_passes(tmp_path):
     p, r = lint(tmp_path, eds(var(2000), [0x2000]))
     assert r.returncode == 0, r.stderr
@@ -116,15 +129,16 @@ def test_unknown_object_code(tmp_path):
 
 
 def test_missing_default_value_ro(tmp_path):
-    expect(tmp_path, eds(var(2000, AccessType="ro", DefaultValue=None), [0x2000]), "[2000]",
-           "missing DefaultValue")
+    expect_warning(tmp_path, eds(var(2000, AccessType="ro", DefaultValue=None), [0x2000]),
+                   "[2000]", "no DefaultValue for a ro UNSIGNED16; the value starts at 0")
 
 
 def test_missing_default_value_sub0(tmp_path):
     body = ("[2000]\nParameterName=Rec\nObjectType=0x9\nSubNumber=2\n\n"
             "[2000sub0]\nParameterName=Highest\nDataType=0x0005\nAccessType=ro\n\n"
             "[2000sub1]\nParameterName=A\nDataType=0x0005\nAccessType=rw\nDefaultValue=0\n")
-    expect(tmp_path, eds(body, [0x2000]), "[2000sub0]", "missing DefaultValue")
+    expect_warning(tmp_path, eds(body, [0x2000]), "[2000sub0]",
+                   "2000h:0 has no DefaultValue; 1 (the highest sub-index) is used")
 
 
 def test_value_above_high_limit(tmp_path):
@@ -167,7 +181,8 @@ def test_subnumber_mismatch(tmp_path):
     body = ("[2000]\nParameterName=Rec\nObjectType=0x9\nSubNumber=3\n\n"
             "[2000sub0]\nParameterName=Highest\nDataType=0x0005\nAccessType=ro\nDefaultValue=1\n\n"
             "[2000sub1]\nParameterName=A\nDataType=0x0005\nAccessType=rw\nDefaultValue=0\n")
-    expect(tmp_path, eds(body, [0x2000]), "SubNumber=3", "SubNumber=3 but 2 sub-index sections")
+    expect_warning(tmp_path, eds(body, [0x2000]), "SubNumber=3",
+                   "SubNumber=3 but 2 sub-index sections")
 
 
 def test_subnumber_and_compactsubobj(tmp_path):
@@ -183,10 +198,10 @@ def test_compactsubobj_with_sub_sections(tmp_path):
     expect(tmp_path, eds(body, [0x2000]), "[2000sub1]", "has sub-index sections")
 
 
-def test_compactsubobj_on_record(tmp_path):
-    body = ("[2000]\nParameterName=Rec\nObjectType=0x9\nCompactSubObj=2\n"
+def test_compactsubobj_on_defstruct(tmp_path):
+    body = ("[2000]\nParameterName=Rec\nObjectType=0x6\nCompactSubObj=2\n"
             "DataType=0x0005\nAccessType=rw\nDefaultValue=0\n")
-    expect(tmp_path, eds(body, [0x2000]), "CompactSubObj=2", "only allowed on ARRAY")
+    expect(tmp_path, eds(body, [0x2000]), "CompactSubObj=2", "only allowed on ARRAY and RECORD")
 
 
 def test_array_without_subnumber(tmp_path):
@@ -213,7 +228,7 @@ def test_duplicate_index_section(tmp_path):
 
 def test_duplicate_index_in_object_lists(tmp_path):
     text = eds(var(2000), [0x2000, 0x2000])
-    expect(tmp_path, text, "2=0x2000", "duplicate index 2000h in object lists")
+    expect_warning(tmp_path, text, "2=0x2000", "duplicate index 2000h in object lists")
 
 
 def test_duplicate_sub_index(tmp_path):
@@ -231,18 +246,18 @@ def test_duplicate_key(tmp_path):
 
 
 def test_listed_object_without_section(tmp_path):
-    expect(tmp_path, eds(var(2000), [0x2000, 0x2001]), "2=0x2001",
-           "index 2001h listed in [ManufacturerObjects] has no section")
+    expect_warning(tmp_path, eds(var(2000), [0x2000, 0x2001]), "2=0x2001",
+                   "index 2001h listed in [ManufacturerObjects] has no section")
 
 
 def test_section_not_listed(tmp_path):
-    expect(tmp_path, eds(var(2000) + var(2001), [0x2000]), "[2001]",
-           "is not listed in any object list")
+    expect_warning(tmp_path, eds(var(2000) + var(2001), [0x2000]), "[2001]",
+                   "is not listed in any object list")
 
 
 def test_supported_objects_count(tmp_path):
     text = eds(var(2000), [0x2000]).replace("SupportedObjects=1", "SupportedObjects=2")
-    expect(tmp_path, text, "SupportedObjects=2", "SupportedObjects=2 but")
+    expect_warning(tmp_path, text, "SupportedObjects=2", "SupportedObjects=2 but")
 
 
 def test_array_types_differ(tmp_path):
