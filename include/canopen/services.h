@@ -34,6 +34,9 @@
 #if defined(CONFIG_CANOPEN_LSS) || defined(__DOXYGEN__)
 #include <canopen/lss.h>
 #endif
+#if defined(CONFIG_CANOPEN_LSS_MASTER) || defined(__DOXYGEN__)
+#include <canopen/lss_master.h>
+#endif
 #if defined(CONFIG_CANOPEN_EMCY) || defined(__DOXYGEN__)
 #include <canopen/emcy.h>
 #endif
@@ -73,6 +76,7 @@
 /* clang-format off */
 #define CO_NODE_SERVICES(X)                                                                        \
 	IF_ENABLED(CONFIG_CANOPEN_LSS, (X(lss, struct co_lss lss)))                                \
+	IF_ENABLED(CONFIG_CANOPEN_LSS_MASTER, (X(lss_master, struct co_lss_master lssm)))          \
 	IF_ENABLED(CONFIG_CANOPEN_REDUNDANCY, (X(redundancy, struct co_redundancy rdn)))           \
 	X(errctl, struct co_errctl ec)                                                             \
 	IF_ENABLED(CONFIG_CANOPEN_EMCY, (X(emcy, struct co_emcy emcy)))                            \
