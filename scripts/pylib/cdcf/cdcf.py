@@ -116,7 +116,7 @@ def decode(blob: bytes):
 # Reading the DCF
 
 
-def _read(path: str):
+def _read(path: str, strict: bool = False):
     with open(path, "rb") as f:
         raw = f.read()
     try:
@@ -125,10 +125,10 @@ def _read(path: str):
         text = raw.decode("latin-1")
     if text.startswith("\ufeff"):
         text = text[1:]
-    rd = Reader(path, text)
+    rd = Reader(path, text, strict)
     model = Builder(rd, True).build()
     if rd.errors:
-        raise LintError(rd.errors)
+        raise LintError(rd.errors, rd.warnings)
     return rd, model
 
 
@@ -182,10 +182,11 @@ def _writable(it: Item):
 
 
 class Generator:
-    def __init__(self, path, node_id=None, defaults=False, save=False):
+    def __init__(self, path, node_id=None, defaults=False, save=False, strict=False):
         self.path = path
         self.errors = []
-        self.rd, self.model = _read(path)
+        self.rd, self.model = _read(path, strict)
+        self.warnings = self.rd.warnings
         self.node_id = node_id if node_id is not None else self.model.node_id
         self.defaults = defaults
         self.save = save
@@ -342,9 +343,13 @@ def _line_key(msg):
     return int(m.group(2)) if m else 0
 
 
-def generate(path, node_id=None, defaults=False, save=False):
-    """Read and check a DCF; return its concise DCF entries (raise LintError)."""
-    return Generator(path, node_id, defaults, save).entries()
+def generate(path, node_id=None, defaults=False, save=False, strict=False, warnings=None):
+    """Read and check a DCF; return its concise DCF entries (raise LintError). The reader's
+    warnings are appended to the list `warnings` when given."""
+    g = Generator(path, node_id, defaults, save, strict)
+    if warnings is not None:
+        warnings.extend(g.warnings)
+    return g.entries()
 
 
 # --------------------------------------------------------------------------------------

@@ -42,6 +42,8 @@ def main(argv=None) -> int:
     ap.add_argument("--save", action="store_true",
                     help="end with 1010h:01 = \"save\" so the slave keeps the configuration")
     ap.add_argument("--list", action="store_true", help="print the entries")
+    ap.add_argument("--strict", action="store_true",
+                    help="treat the reader's warnings (what CiA 306 allows) as errors")
     ap.add_argument("--decode", action="store_true",
                     help="read a concise DCF .bin and print its entries")
     args = ap.parse_args(argv)
@@ -57,15 +59,19 @@ def main(argv=None) -> int:
         sys.stdout.write(cdcf.listing(entries))
         return 0
 
+    warnings = []
     try:
-        entries = cdcf.generate(args.dcf, args.node_id, args.defaults, args.save)
+        entries = cdcf.generate(args.dcf, args.node_id, args.defaults, args.save, args.strict,
+                                warnings)
     except LintError as e:
-        for m in e.messages:
+        for m in warnings + e.warnings + e.messages:
             print(m, file=sys.stderr)
         return 1
     except OSError as e:
         print(f"{args.dcf}: {e.strerror}", file=sys.stderr)
         return 1
+    for m in warnings:
+        print(m, file=sys.stderr)
     blob = cdcf.encode(entries)
     if args.output:
         write_file(args.output, blob)

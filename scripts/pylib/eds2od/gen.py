@@ -8,7 +8,6 @@ subsys/canopen/od/od_eds.c); both follow the same rules so that a test can compa
 
 from __future__ import annotations
 
-import re
 import struct
 
 from . import dtypes

@@ -476,16 +476,19 @@ class Builder:
 
     def check_sizes(self, objects):
         total = 0
+        bad = False
         for o in objects:
             for s in o.subs:
                 if s.size > MAX_VALUE_SIZE:
                     line = s.sec.line_of("SafeLineSize") if s.sec is not None else s.line
-                    self.err(line, f"{o.index:04X}h:{s.sub}: {s.dtype.name} of {s.size} bytes; "
+                    where = f"{o.index:04X}h" if o.objcode in (0x2, 0x5, 0x7) \
+                        else f"{o.index:04X}h:{s.sub}"
+                    self.err(line, f"{where}: {s.dtype.name} of {s.size} bytes; "
                                    f"at most {MAX_VALUE_SIZE} bytes are held in RAM (use a "
                                    "DOMAIN of size 0 with an object provider for more)")
-                    return
+                    bad = True
                 total += s.size
-        if total > MAX_RAM:
+        if total > MAX_RAM and not bad:
             self.err(objects[0].line if objects else 1,
                      f"the dictionary's values take {total} bytes; at most {MAX_RAM} are allowed")
 
