@@ -36,6 +36,9 @@
 #include <canopen/event.h>
 #include <canopen/line.h>
 #include <canopen/nmt.h>
+#if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
+#include <canopen/mgr_lss.h>
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -320,6 +323,9 @@ struct co_mgr {
 	void *ec_user_data;
 	co_mgr_sw_ind_t sw_ind;
 	void *sw_user_data;
+#if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
+	struct co_mgr_lss lss; /* node-IDs for missing slaves by LSS (mgr_lss.c) */
+#endif
 };
 /** @endcond */
 

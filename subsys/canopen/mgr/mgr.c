@@ -140,6 +140,11 @@ static int mgr_init(struct co_node *node)
 	if (co_node_listener_add(node, &m->listener) != 0) {
 		return -ENOSPC;
 	}
+#if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
+	if (co_mgr_lss_init(m) != 0) {
+		return -ENOSPC;
+	}
+#endif
 	return co_mgr_od_hooks_register(m);
 }
 

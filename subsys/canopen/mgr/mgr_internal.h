@@ -198,4 +198,9 @@ void co_mgr_boot_timer_handler(struct co_timer *timer, uint64_t now_us);
 void co_mgr_set_nmt_view(struct co_mgr_slave *s, uint8_t v);
 int co_mgr_od_hooks_register(struct co_mgr *m);
 
+/* --- mgr_lss.c: node-IDs for missing slaves by LSS -------------------------------------------- */
+
+/* Follow the boot results: a slave ending with B is searched by fastscan. */
+int co_mgr_lss_init(struct co_mgr *m);
+
 #endif /* SAFELINE_SUBSYS_CANOPEN_MGR_MGR_INTERNAL_H_ */
