@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import re
 import sys
@@ -20,6 +21,35 @@ def write_file(path: str, text: str):
     with open(tmp, "wb") as f:
         f.write(data)
     os.replace(tmp, path)
+
+
+class _LogToWarnings(logging.Handler):
+    """python-canopen logs what it dislikes; each record becomes a warning naming the file."""
+
+    def __init__(self, path: str, warnings: list):
+        super().__init__(logging.WARNING)
+        self.path = path
+        self.warnings = warnings
+
+    def emit(self, record):
+        self.warnings.append(f"{self.path}: warning: python-canopen: {record.getMessage()}")
+
+
+def crosscheck_quoting_log(model, path: str):
+    """crosscheck() with python-canopen's log messages as warnings, every message on one line
+    (python-canopen's exceptions quote the file's lines, newlines included)."""
+    log = logging.getLogger("canopen")
+    handler = _LogToWarnings(path, model.warnings)
+    saved = log.propagate
+    log.addHandler(handler)
+    log.propagate = False
+    try:
+        problems = crosscheck(model, path)
+    finally:
+        log.removeHandler(handler)
+        log.propagate = saved
+    model.warnings = [re.sub(r"\s*\n\s*", " ", m) for m in model.warnings]
+    return [re.sub(r"\s*\n\s*", " ", m) for m in problems]
 
 
 def main(argv=None) -> int:
@@ -52,7 +82,7 @@ def main(argv=None) -> int:
         print(f"eds2od: {e}", file=sys.stderr)
         return 2
     if not args.no_crosscheck:
-        problems = crosscheck(model, args.input)
+        problems = crosscheck_quoting_log(model, args.input)
         for m in model.warnings:
             print(m, file=sys.stderr)
         if problems:
