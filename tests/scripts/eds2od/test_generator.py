@@ -109,13 +109,33 @@ def test_cmake_module_declares_the_function():
     assert "scripts/eds2od" in text
 
 
+def test_safeline_keys_as_comments(tmp_path):
+    """;SafeLineSize=n and ;SafeLineStore=0|1 (the form dcfchk skips) work as the keys do; a
+    comment that is no SafeLine key stays a comment."""
+    with open(os.path.join(DATA, "minimal.eds")) as f:
+        text = f.read()
+    text = text.replace("[ManufacturerObjects]\nSupportedObjects=0\n",
+                        "[ManufacturerObjects]\nSupportedObjects=1\n1=0x2000\n", 1)
+    text += ("\n[2000]\nParameterName=Label\nDataType=0x0009\nAccessType=rw\nDefaultValue=ab\n"
+             ";SafeLineSize=32\n; SafeLineStore=0\n;DefaultValue=abcdef\n")
+    src = tmp_path / "cmt.eds"
+    src.write_text(text)
+    out = tmp_path / "gen"
+    r = run_eds2od(src, out, "cmt")
+    assert r.returncode == 0, r.stderr
+    h = (out / "cmt_od.h").read_text()
+    assert "char x2000_label[33];" in h
+    assert re.search(r"struct \{\n\t\tchar x2000_label\[33\];\n\t\} manuf_vol;", h)
+    assert "DefaultValue=ab\n" in (out / "cmt.eds").read_text()
+
+
 def test_store_override(tmp_path):
     """SafeLineStore=0 keeps a writable parameter out of its group, =1 puts one in."""
     with open(os.path.join(DATA, "minimal.eds")) as f:
         text = f.read()
-    text = text.replace("SupportedObjects=3\n1=0x1000", "SupportedObjects=3\n1=0x1000", 1)
-    text += ("\n[ManufacturerObjects]\nSupportedObjects=2\n1=0x2000\n2=0x2001\n\n"
-             "[2000]\nParameterName=Scratch\nDataType=0x0007\nAccessType=rw\nDefaultValue=0\n"
+    text = text.replace("[ManufacturerObjects]\nSupportedObjects=0\n",
+                        "[ManufacturerObjects]\nSupportedObjects=2\n1=0x2000\n2=0x2001\n", 1)
+    text += ("\n[2000]\nParameterName=Scratch\nDataType=0x0007\nAccessType=rw\nDefaultValue=0\n"
              "SafeLineStore=0\n\n"
              "[2001]\nParameterName=Kept\nDataType=0x0007\nAccessType=rw\nDefaultValue=0\n")
     src = tmp_path / "store.eds"

@@ -216,6 +216,17 @@ def test_malformed_nodeid_formula(tmp_path, formula):
            f"DefaultValue={formula}", "malformed $NODEID formula")
 
 
+@pytest.mark.parametrize("formula", ["0x180+$NODEID", "$NODEID+0x180", "$NODEID + 384",
+                                     "384 + $nodeid"])
+def test_nodeid_formula_either_order(tmp_path, formula):
+    """CiA 306 writes $NODEID+n; files also say n+$NODEID (dcfchk takes only the first)."""
+    p, r = lint(tmp_path, eds(var(2000, DataType="0x0007", DefaultValue=formula), [0x2000]))
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
+    r = run_eds2od(p, tmp_path / "gen", "nid")
+    assert r.returncode == 0, r.stderr
+    assert "DefaultValue=$NODEID+0x180\n" in (tmp_path / "gen" / "nid.eds").read_text()
+
+
 def test_nodeid_on_non_integer(tmp_path):
     expect(tmp_path, eds(var(2000, DataType="0x0008", DefaultValue="$NODEID+1"), [0x2000]),
            "DefaultValue=$NODEID+1", "only allowed for integer types")

@@ -3,6 +3,7 @@
 """EDS -> C -> EDS written by the firmware -> python-canopen reads the same dictionary."""
 
 import os
+import re
 import struct
 import subprocess
 
@@ -32,6 +33,29 @@ def same_value(data_type, a, b):
     return a == b
 
 
+def decimal_reals(path, tmp_path):
+    """A copy of the EDS with REAL values written as IEEE 754 bit patterns (the form lely's
+    dcfchk needs) turned into decimals, the only form python-canopen reads (whole numbers
+    without a point: it reads REAL limits with int())."""
+
+    def dec(fmt, ifmt, text):
+        f = struct.unpack(fmt, struct.pack(ifmt, int(text, 16)))[0]
+        return str(int(f)) if f.is_integer() else repr(f)
+
+    sections = re.split(r"(?m)^(?=\[)", open(path, encoding="utf-8").read())
+    for i, sec in enumerate(sections):
+        m = re.search(r"(?m)^DataType=0x00(08|11)$", sec)
+        if not m:
+            continue
+        fmt, ifmt = ("<f", "<I") if m.group(1) == "08" else ("<d", "<Q")
+        sections[i] = re.sub(
+            r"(?m)^(DefaultValue|ParameterValue|LowLimit|HighLimit)=(0x[0-9A-Fa-f]+)$",
+            lambda k: f"{k.group(1)}={dec(fmt, ifmt, k.group(2))}", sec)
+    out = tmp_path / ("decimal_" + os.path.basename(path))
+    out.write_text("".join(sections), encoding="utf-8")
+    return str(out)
+
+
 def expected_default(v):
     # A DCF's ParameterValue is what the firmware holds as its default.
     return v.value if getattr(v, "value", None) is not None else v.default
@@ -56,7 +80,7 @@ def test_python_canopen_reads_the_same_objects(eds, name, tmp_path):
     regen = tmp_path / "firmware.eds"
     regen.write_bytes(subprocess.run([str(exe)], capture_output=True, check=True).stdout)
 
-    src = canopen.import_od(os.path.join(DATA, eds), node_id=5)
+    src = canopen.import_od(decimal_reals(os.path.join(DATA, eds), tmp_path), node_id=5)
     fw = canopen.import_od(str(regen), node_id=5)
     a, b = flatten(src), flatten(fw)
     compact = {o.index for o in src.values()

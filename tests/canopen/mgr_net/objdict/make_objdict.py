@@ -125,7 +125,7 @@ class Dict:
             return (f"[{name}]\nSupportedObjects={len(objs)}\n"
                     + "".join(f"{i + 1}=0x{o:04X}\n" for i, o in enumerate(objs)) + "\n")
         self.parts.insert(0, lst("MandatoryObjects", mandatory) + lst("OptionalObjects", optional)
-                          + (lst("ManufacturerObjects", manufacturer) if manufacturer else ""))
+                          + lst("ManufacturerObjects", manufacturer))  # even empty: dcfchk
 
     def identity(self, product, revision, serial):
         self.var(0x1000, "Device type", 7, "ro", f"0x{DEVICE_TYPE:08X}")

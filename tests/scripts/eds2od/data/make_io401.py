@@ -125,7 +125,9 @@ for ch in range(64):
     obj_multi(0x2100 + ch, f"Channel {ch} configuration", 0x9, [
         ("Highest sub-index supported", U8, "const", 5),
         ("Mode", U8, "rw", 0, 0, 0, 3), ("Debounce time", U16, "rw", 10, 0, 0, 1000),
-        ("Scale", R32, "rw", "1.0", 0, "-100", "100"), ("Label", VS, "rw", f"CH{ch}"),
+        # REAL32 1.0, -100.0, 100.0 as IEEE 754 bit patterns (the form lely's dcfchk reads)
+        ("Scale", R32, "rw", "0x3F800000", 0, "0xC2C80000", "0x42C80000"),
+        ("Label", VS, "rw", f"CH{ch}"),
         ("Enabled", BOOL, "rw", 1)])
 obj_var(0x2000, "Operating hours", U32, "ro", "0", pdo=1)
 obj_var(0x2001, "Board temperature", I16, "ro", "0", pdo=1)
