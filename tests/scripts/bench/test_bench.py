@@ -167,3 +167,15 @@ def test_pytest_benchmarks_are_told_apart_and_their_json_is_read(tmp_path, monke
     monkeypatch.setattr(bench, "run", fake_run)
     figs = bench.pytest_bench(str(src), str(out), 10)
     assert figs == [{"name": "b.one", "v": 1}, {"name": "b.two", "v": 2}]
+
+
+def test_a_vcan_benchmark_runs_in_the_vm_and_others_do_not(tmp_path, monkeypatch):
+    cmds = []
+    monkeypatch.setattr(bench, "run", lambda cmd, timeout: (cmds.append(cmd), (0, ""))[1])
+    for name, fixture in (("plain", ""), ("vm", "    harness_config:\n      fixture: vcan\n")):
+        src = tmp_path / name / "bench"
+        src.mkdir(parents=True)
+        (src / "testcase.yaml").write_text(f"tests:\n  a.bench:\n    harness: pytest\n{fixture}")
+        bench.pytest_bench(str(src), str(tmp_path / name / "out"), 10)
+    assert "-X" not in cmds[0]
+    assert cmds[1][cmds[1].index("-X") + 1] == "vcan"
