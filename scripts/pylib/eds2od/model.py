@@ -834,8 +834,11 @@ class Builder:
             self.warn(sec.line, f"{where}: no DefaultValue for a {acc} {t.name}; the value "
                                 "starts at 0")
         if pdo_map and (t.cls == "DOMAIN" or (t.size == 0 and size > 8) or size == 0):
-            self.err(sec.line_of("PDOMapping"), f"{where}: {t.name} of {size} bytes cannot be "
-                                                "mapped to a PDO")
+            # Other stacks write PDOMapping=1 on such values; no PDO can carry them, so the
+            # flag is dropped (a mapping entry naming one is then refused or warned about).
+            self.warn(sec.line_of("PDOMapping"), f"{where}: {t.name} of {size} bytes cannot be "
+                                                 "mapped to a PDO; PDOMapping=1 is ignored")
+            s.pdo_map = False
         self.check_limits(s, sec.line_of("DefaultValue") if sec.get("ParameterValue") is None
                           else sec.line_of("ParameterValue"), sec)
         return s

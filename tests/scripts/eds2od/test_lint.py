@@ -167,14 +167,15 @@ def test_value_out_of_type_range(tmp_path):
 
 
 def test_pdo_mapping_of_domain(tmp_path):
-    expect(tmp_path, eds(var(2000, DataType="0x000F", DefaultValue=None, PDOMapping="1"),
-                         [0x2000]), "PDOMapping=1", "cannot be mapped to a PDO")
+    expect_warning(tmp_path, eds(var(2000, DataType="0x000F", DefaultValue=None,
+                                     PDOMapping="1"), [0x2000]), "PDOMapping=1",
+                   "cannot be mapped to a PDO; PDOMapping=1 is ignored")
 
 
 def test_pdo_mapping_of_long_string(tmp_path):
-    expect(tmp_path, eds(var(2000, DataType="0x0009", DefaultValue="twelve chars",
-                             PDOMapping="1"), [0x2000]), "PDOMapping=1",
-           "VISIBLE_STRING of 12 bytes cannot be mapped")
+    expect_warning(tmp_path, eds(var(2000, DataType="0x0009", DefaultValue="twelve chars",
+                                     PDOMapping="1"), [0x2000]), "PDOMapping=1",
+                   "VISIBLE_STRING of 12 bytes cannot be mapped")
 
 
 def test_subnumber_mismatch(tmp_path):
