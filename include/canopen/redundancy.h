@@ -135,6 +135,9 @@ struct co_redundancy {
 	uint8_t tpdo_max;
 	/* Lines whose controller cannot send (error passive, bus-off): no process data there. */
 	uint8_t tx_excluded;
+	/* Lines whose sends fail with -ENETDOWN/-ENETUNREACH until a frame comes in there. */
+	uint8_t link_down;
+	uint8_t excluded_now; /* tx_excluded | link_down as last applied */
 	bool tpdo_failed;
 	uint32_t switches;
 	co_rdn_veto_t veto;

@@ -134,6 +134,8 @@ static void step(struct co_node *node, enum rdn_input input, uint64_t now)
 
 /* --- Heartbeats per line -------------------------------------------------------------------- */
 
+static void link_state(struct co_node *node, uint8_t idx, bool down);
+
 static bool default_line_ok(const struct co_redundancy *r)
 {
 	for (uint8_t i = 0; i < r->n_hb; i++) {
@@ -242,6 +244,10 @@ static void hb_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	bool was_ok = default_line_ok(r);
 	uint8_t i;
 
+	if ((r->link_down & BIT(line)) != 0U) {
+		/* Frames come in there again: the interface is back up. */
+		link_state(node, line, false);
+	}
 	if ((frame->flags & CAN_FRAME_RTR) != 0U || frame->dlc < 1U) {
 		return;
 	}
@@ -305,6 +311,20 @@ static bool keep_ec(const struct can_frame *frame, void *arg)
  * line delivered long before. Such a line gets no process data until its controller is back
  * below error passive, and what the node queued there is withdrawn.
  */
+static void exclusion_update(struct co_node *node, uint8_t idx)
+{
+	struct co_redundancy *r = &node->rdn;
+	uint8_t excluded = (uint8_t)(r->tx_excluded | r->link_down);
+	uint8_t bit = (uint8_t)BIT(idx);
+	bool was = (r->excluded_now & bit) != 0U;
+
+	r->excluded_now = excluded;
+	co_node_set_tx_excluded(node, excluded);
+	if (!was && (excluded & bit) != 0U) {
+		(void)co_line_tx_purge(node->lines[idx].line, &node->lock, keep_ec, NULL);
+	}
+}
+
 static void line_state(struct co_node *node, uint8_t idx, int state)
 {
 	struct co_redundancy *r = &node->rdn;
@@ -315,10 +335,32 @@ static void line_state(struct co_node *node, uint8_t idx, int state)
 		return;
 	}
 	r->tx_excluded = down ? (uint8_t)(r->tx_excluded | bit) : (uint8_t)(r->tx_excluded & ~bit);
-	co_node_set_tx_excluded(node, r->tx_excluded);
-	if (down) {
-		(void)co_line_tx_purge(node->lines[idx].line, &node->lock, keep_ec, NULL);
+	exclusion_update(node, idx);
+}
+
+/*
+ * A send refused with -ENETDOWN or -ENETUNREACH: the interface is down (SocketCAN after
+ * ip link set ... down; its driver reports no controller state) or the controller stopped.
+ * The line gets no process data until a frame is received on it again.
+ */
+static bool link_error(int err)
+{
+	return err == -ENETDOWN || err == -ENETUNREACH;
+}
+
+static void link_state(struct co_node *node, uint8_t idx, bool down)
+{
+	struct co_redundancy *r = &node->rdn;
+	uint8_t bit = (uint8_t)BIT(idx);
+
+	if (down == ((r->link_down & bit) != 0U)) {
+		return;
 	}
+	r->link_down = down ? (uint8_t)(r->link_down | bit) : (uint8_t)(r->link_down & ~bit);
+	LOG_INF("%s: line %u %s", node->name, idx,
+		down ? "cannot send: no process data there"
+		     : "receives again: process data resume");
+	exclusion_update(node, idx);
 }
 
 /* --- TPDO 1 supervision --------------------------------------------------------------------- */
@@ -332,10 +374,17 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 	if (ev->type == CO_EV_LINE) {
 		if (two_lines(node) && ev->line.event == CO_LINE_EV_CAN_STATE) {
 			line_state(node, ev->line.idx, ev->line.arg);
+		} else if (two_lines(node) && ev->line.event == CO_LINE_EV_TX_ERROR &&
+			   link_error(ev->line.arg)) {
+			link_state(node, ev->line.idx, true);
 		}
 		return 0;
 	}
 	if (ev->type != CO_EV_TPDO || ev->tpdo.num != 0U || r->tpdo_max == 0U) {
+		return 0;
+	}
+	/* A line that cannot send is left out of the route (above), not a TPDO 1 failure. */
+	if (two_lines(node) && link_error(ev->tpdo.err)) {
 		return 0;
 	}
 	/* Capped at the limit: twelve good sends resume after any number of failures. */

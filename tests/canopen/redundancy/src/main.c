@@ -46,6 +46,10 @@ static struct {
 	struct sent tx[2][MAX_TX];
 	int n_tx[2];
 	bool busy;
+	/* The line's interface is down: the driver refuses every frame with -ENETDOWN. */
+	bool down[2];
+	uint32_t refused[2][MAX_TX];
+	int n_refused[2];
 	struct co_event ev[MAX_EV];
 	int n_ev;
 	int n_sync;
@@ -59,6 +63,11 @@ static int sink(struct co_line *line, const struct can_frame *frame, void *user_
 
 	if (t.busy) {
 		return -EAGAIN;
+	}
+	if (t.down[l]) {
+		zassert_true(t.n_refused[l] < MAX_TX);
+		t.refused[l][t.n_refused[l]++] = frame->id;
+		return -ENETDOWN;
 	}
 	zassert_true(t.n_tx[l] < MAX_TX, "too many frames on line %d", l);
 	t.tx[l][t.n_tx[l]++] = (struct sent){*frame, t.now};
@@ -363,6 +372,53 @@ ZTEST(co_redundancy, test_a_line_that_cannot_send_gets_no_process_data_and_drops
 	zassert_ok(co_tpdo_send_req(&t.node, 0));
 	zassert_equal(count_id(D, 0x181), 1, "back on both lines");
 	zassert_equal(count_id(R, 0x181), 2);
+}
+
+static int count_refused(int l, uint32_t id)
+{
+	int n = 0;
+
+	for (int i = 0; i < t.n_refused[l]; i++) {
+		n += t.refused[l][i] == id;
+	}
+	return n;
+}
+
+/* SocketCAN after ip link set ... down: no controller state, every send refused. */
+ZTEST(co_redundancy, test_a_line_whose_sends_fail_with_enetdown_gets_no_process_data)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+
+	rx(D, 0x000, 2, start);
+	run_until(t.now + 1 * MS);
+	t.down[D] = true;
+	/* Three refused before the line thread hears of it: no TPDO 1 failure for a link. */
+	for (int i = 0; i < 3; i++) {
+		(void)co_tpdo_send_req(&t.node, 0);
+	}
+	zassert_equal(count_refused(D, 0x181), 3);
+	run_until(t.now + 1 * MS);
+	t.n_refused[D] = 0;
+	t.n_tx[R] = 0;
+	for (int i = 0; i < 20; i++) {
+		zassert_ok(co_tpdo_send_req(&t.node, 0));
+	}
+	zassert_equal(count_refused(D, 0x181), 0, "no process data tried on the down line");
+	zassert_equal(count_id(R, 0x181), 20);
+	run_until(t.now + 120 * MS);
+	zassert_true(count_refused(D, 0x701) >= 2, "the heartbeat is still tried there");
+	zassert_true(count_id(R, 0x701) >= 2, "and still goes out on the other line");
+	zassert_is_null(last_rdn(CO_RDN_EV_TPDO_FAILED), "a link down is no TPDO 1 failure");
+
+	/* The link is back, but nothing says so until a frame comes in there. */
+	t.down[D] = false;
+	t.n_tx[D] = 0;
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(count_id(D, 0x181), 0);
+	heartbeat(D, 2);
+	run_until(t.now + 1 * MS);
+	zassert_ok(co_tpdo_send_req(&t.node, 0));
+	zassert_equal(count_id(D, 0x181), 1, "back on both lines");
 }
 
 ZTEST(co_redundancy, test_queued_process_data_withdrawn_when_the_line_goes_error_passive)
