@@ -784,8 +784,12 @@ class Builder:
                 continue
             if v == "" and t.cls not in ("VSTR", "OSTR", "USTR", "DOMAIN"):
                 # CiA 306 allows an empty value; a limit that is empty is no limit.
-                if key in ("DefaultValue", "ParameterValue"):
-                    self.warn(sec.line_of(key), f"{where}: empty {key}; the value starts at 0")
+                if key == "DefaultValue":
+                    self.warn(sec.line_of(key), f"{where}: empty DefaultValue; the value starts "
+                                                "at 0")
+                elif key == "ParameterValue":
+                    self.warn(sec.line_of(key), f"{where}: empty ParameterValue; the "
+                                                "DefaultValue stays")
                 continue
             try:
                 val = parse_value(t, v, f"{where}: {key}")

@@ -267,6 +267,13 @@ def test_section_not_listed(tmp_path):
                    "is not listed in any object list")
 
 
+def test_list_without_supported_objects(tmp_path):
+    text = eds(var(2000), [0x2000]).replace("[ManufacturerObjects]\nSupportedObjects=1\n",
+                                            "[ManufacturerObjects]\n")
+    expect_warning(tmp_path, text, "[ManufacturerObjects]",
+                   "[ManufacturerObjects] has no SupportedObjects")
+
+
 def test_supported_objects_count(tmp_path):
     text = eds(var(2000), [0x2000]).replace("SupportedObjects=1", "SupportedObjects=2")
     expect_warning(tmp_path, text, "SupportedObjects=2", "SupportedObjects=2 but")
