@@ -18,6 +18,7 @@
 #include <zephyr/sys/byteorder.h>
 
 #include <canopen/od.h>
+#include <canopen/pdo.h>
 
 #include "fuzz.h"
 #include "fuzz_node_od.h"
@@ -219,18 +220,36 @@ static const struct cfg cfg_pdo[] = {
 	{0x1007, 0, 4, 5000},
 };
 
+/* Variant bit 0: RPDO 2/3 and TPDO 2/3 as MPDOs (DAM on 321h/2A1h, SAM on 322h/2A2h). */
+#define MPDO(comm, map, cob, type, mode)                                                           \
+	{comm, 1, 4, 0x80000000U | (cob)}, {comm, 2, 1, type}, {map, 0, 1, 0}, {map, 0, 1, mode},  \
+	{                                                                                          \
+		comm, 1, 4, cob                                                                    \
+	}
+static const struct cfg cfg_mpdo[] = {
+	{0x1006, 0, 4, 10000},
+	MPDO(0x1401, 0x1601, 0x321, 255, CO_MPDO_DAM),
+	MPDO(0x1402, 0x1602, 0x322, 254, CO_MPDO_SAM),
+	MPDO(0x1801, 0x1A01, 0x2A1, 255, CO_MPDO_DAM),
+	MPDO(0x1802, 0x1A02, 0x2A2, 254, CO_MPDO_SAM),
+};
+
 static void setup_pdo(const uint8_t **data, size_t *size)
 {
-	node_up(cfg_pdo, ARRAY_SIZE(cfg_pdo), data, size);
+	if (*size > 0U && ((*data)[0] & 1U) != 0U) {
+		node_up(cfg_mpdo, ARRAY_SIZE(cfg_mpdo), data, size);
+	} else {
+		node_up(cfg_pdo, ARRAY_SIZE(cfg_pdo), data, size);
+	}
 }
 
 static const uint32_t ids_pdo[] = {FZ_REL(0x200), FZ_REL(0x300), FZ_REL(0x400), FZ_REL(0x500),
 				   FZ_REL(0x180), FZ_REL(0x280), 0x080,         0x000,
-				   FZ_REL(0x600), 0x201,         0x0FF};
+				   FZ_REL(0x600), 0x321,         0x322,         0x2A1};
 
 const struct fz_harness fz_pdo = {
 	.name = "pdo",
-	.what = "RPDOs, RTR on TPDOs, SYNC-driven PDOs, MPDO frames",
+	.what = "RPDOs, RTR on TPDOs, SYNC-driven PDOs; DAM and SAM MPDOs (variant bit 0)",
 	.setup = setup_pdo,
 	.ids = ids_pdo,
 	.n_ids = ARRAY_SIZE(ids_pdo),
