@@ -39,6 +39,9 @@
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 #include <canopen/mgr_lss.h>
 #endif
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+#include <canopen/pgm.h>
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -99,6 +102,19 @@ enum co_mgr_step {
 	CO_MGR_STEP_KEEP_ALIVE_RESET,
 	CO_MGR_STEP_SW_DATE,
 	CO_MGR_STEP_SW_TIME,
+	/** Program download (CONFIG_CANOPEN_MGR_PGM, mgr_pgm.c): 1F51h:01 = 0. */
+	CO_MGR_STEP_PGM_STOP,
+	/** 1F50h:01 = the image, block SDO. */
+	CO_MGR_STEP_PGM_DOWNLOAD,
+	/** 1F51h:01 = 1. */
+	CO_MGR_STEP_PGM_START,
+	/** Wait for the boot-up of the slave restarting with the new image. */
+	CO_MGR_STEP_PGM_RESTART,
+	/** 1F52h:01/02 read again. */
+	CO_MGR_STEP_PGM_DATE,
+	CO_MGR_STEP_PGM_TIME,
+	/** The download failed: 1F51h:01 = 1 so the old program runs again, then I. */
+	CO_MGR_STEP_PGM_RESUME,
 	CO_MGR_STEP_CFG_DATE,
 	CO_MGR_STEP_CFG_TIME,
 	CO_MGR_STEP_RESTORE,
@@ -287,6 +303,12 @@ struct co_mgr_slave {
 	uint8_t line_lost;
 	/* Two lines: the last heartbeat on each, or the start of monitoring. */
 	uint64_t line_hb_us[2];
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+	const void *pgm_image; /* the image being downloaded (the application's memory) */
+	size_t pgm_len;
+	uint32_t pgm_abort; /* abort of the failed download, reported with I */
+	uint8_t pgm_ctrl;   /* 1F51h:01 value on the wire */
+#endif
 };
 
 struct co_mgr_nmt_cmd {
@@ -323,6 +345,10 @@ struct co_mgr {
 	void *ec_user_data;
 	co_mgr_sw_ind_t sw_ind;
 	void *sw_user_data;
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+	co_mgr_pgm_source_t pgm_source;
+	void *pgm_user_data;
+#endif
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 	struct co_mgr_lss lss; /* node-IDs for missing slaves by LSS (mgr_lss.c) */
 #endif

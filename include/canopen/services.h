@@ -61,6 +61,9 @@
 #if defined(CONFIG_CANOPEN_MGR) || defined(__DOXYGEN__)
 #include <canopen/mgr.h>
 #endif
+#if defined(CONFIG_CANOPEN_PGM) || defined(__DOXYGEN__)
+#include <canopen/pgm.h>
+#endif
 #if defined(CONFIG_CANOPEN_LEDS) || defined(__DOXYGEN__)
 #include <canopen/leds.h>
 #endif
@@ -70,7 +73,8 @@
  * runs while the node has no node-ID, and a reset returns it to waiting before anything else
  * is configured), the line choice of a node on two lines (set before anything is sent), error
  * control next (a state change is announced by a heartbeat at once),
- * then EMCY, SYNC, TIME, PDO, SRDO, SDO; the manager after the SDO clients its boot-up uses;
+ * then EMCY, SYNC, TIME, PDO, SRDO, SDO; program download after the SDO server that feeds it;
+ * the manager after the SDO clients its boot-up uses;
  * the indicators, which only listen, last.
  */
 /* clang-format off */
@@ -86,6 +90,7 @@
 	IF_ENABLED(CONFIG_CANOPEN_SRDO, (X(srdo, struct co_srdo srdo)))                            \
 	IF_ENABLED(CONFIG_CANOPEN_SDO_SERVER,                                                      \
 		   (X(sdo_srv, struct co_sdo_srv sdo_srv[CONFIG_CANOPEN_SDO_SERVERS])))            \
+	IF_ENABLED(CONFIG_CANOPEN_PGM, (X(pgm, struct co_pgm pgm)))                                \
 	IF_ENABLED(CONFIG_CANOPEN_SDO_CLIENT,                                                      \
 		   (X(sdo_cli, struct co_sdo_cli sdo_cli[CONFIG_CANOPEN_SDO_CLIENTS])))            \
 	IF_ENABLED(CONFIG_CANOPEN_MGR, (X(mgr, struct co_mgr mgr)))                                \

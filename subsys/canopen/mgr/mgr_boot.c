@@ -348,6 +348,11 @@ static uint8_t st_sw_time_sdo(struct co_mgr_slave *s, uint32_t ab)
 		return fail(s, CO_MGR_ST_H, IDX_SW_VERIFY, date_ok ? 2 : 1, date_ok ? et : ed,
 			    date_ok ? at : s->sw_date, 0U);
 	}
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+	if (co_mgr_pgm_has_image(s)) {
+		return CO_MGR_STEP_PGM_STOP;
+	}
+#endif
 	if (m->sw_ind == NULL ||
 	    m->sw_ind(m->node, s->id, ed, et, s->sw_date, at, m->sw_user_data) != 0) {
 		return fail(s, CO_MGR_ST_I, IDX_SW_VERIFY, date_ok ? 2 : 1, date_ok ? et : ed,
@@ -638,6 +643,30 @@ static const struct boot_state boot_table[CO_MGR_STEP_COUNT] = {
 					  .timeout = st_ka_reset_to},
 	[CO_MGR_STEP_SW_DATE] = {.name = "SW_DATE", .enter = st_sw_date, .sdo = st_sw_date_sdo},
 	[CO_MGR_STEP_SW_TIME] = {.name = "SW_TIME", .enter = st_sw_time, .sdo = st_sw_time_sdo},
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+	[CO_MGR_STEP_PGM_STOP] = {.name = "PGM_STOP",
+				  .enter = co_mgr_pgm_stop,
+				  .sdo = co_mgr_pgm_stop_sdo},
+	[CO_MGR_STEP_PGM_DOWNLOAD] = {.name = "PGM_DOWNLOAD",
+				      .enter = co_mgr_pgm_download,
+				      .sdo = co_mgr_pgm_download_sdo},
+	[CO_MGR_STEP_PGM_START] = {.name = "PGM_START",
+				   .enter = co_mgr_pgm_start,
+				   .sdo = co_mgr_pgm_start_sdo},
+	[CO_MGR_STEP_PGM_RESTART] = {.name = "PGM_RESTART",
+				     .enter = co_mgr_pgm_restart,
+				     .ec = co_mgr_pgm_restart_ec,
+				     .timeout = co_mgr_pgm_restart_to},
+	[CO_MGR_STEP_PGM_DATE] = {.name = "PGM_DATE",
+				  .enter = co_mgr_pgm_date,
+				  .sdo = co_mgr_pgm_date_sdo},
+	[CO_MGR_STEP_PGM_TIME] = {.name = "PGM_TIME",
+				  .enter = co_mgr_pgm_time,
+				  .sdo = co_mgr_pgm_time_sdo},
+	[CO_MGR_STEP_PGM_RESUME] = {.name = "PGM_RESUME",
+				    .enter = co_mgr_pgm_resume,
+				    .sdo = co_mgr_pgm_resume_sdo},
+#endif
 	[CO_MGR_STEP_CFG_DATE] = {.name = "CFG_DATE", .enter = st_cfg_date, .sdo = st_cfg_date_sdo},
 	[CO_MGR_STEP_CFG_TIME] = {.name = "CFG_TIME", .enter = st_cfg_time, .sdo = st_cfg_time_sdo},
 	[CO_MGR_STEP_RESTORE] = {.name = "RESTORE", .enter = st_restore, .sdo = st_restore_sdo},
@@ -659,7 +688,9 @@ static const struct boot_state boot_table[CO_MGR_STEP_COUNT] = {
 
 const char *co_mgr_step_str(enum co_mgr_step step)
 {
-	return (unsigned int)step < CO_MGR_STEP_COUNT ? boot_table[step].name : "?";
+	return (unsigned int)step < CO_MGR_STEP_COUNT && boot_table[step].name != NULL
+		       ? boot_table[step].name
+		       : "?";
 }
 
 /* --- Running the table ------------------------------------------------------------------------ */
@@ -742,6 +773,26 @@ static void sdo_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, vo
 	}
 	boot_run(s, boot_table[s->step].sdo(s, abort_code));
 }
+
+#if defined(CONFIG_CANOPEN_MGR_PGM)
+BUILD_ASSERT(NEXT_WAIT == CO_MGR_NEXT_WAIT && NEXT_END == CO_MGR_NEXT_END);
+
+uint8_t co_mgr_boot_fail(struct co_mgr_slave *s, uint8_t status, uint16_t index, uint8_t sub,
+			 uint32_t expected, uint32_t actual, uint32_t abort_code)
+{
+	return fail(s, status, index, sub, expected, actual, abort_code);
+}
+
+uint8_t co_mgr_boot_upload(struct co_mgr_slave *s, uint16_t index, uint8_t sub)
+{
+	return upload(s, index, sub);
+}
+
+void co_mgr_boot_sdo_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, void *user_data)
+{
+	sdo_con(cli, abort_code, size, user_data);
+}
+#endif
 
 void co_mgr_boot_ec(struct co_mgr_slave *s, uint8_t byte)
 {

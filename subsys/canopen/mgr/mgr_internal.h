@@ -203,4 +203,34 @@ int co_mgr_od_hooks_register(struct co_mgr *m);
 /* Follow the boot results: a slave ending with B is searched by fastscan. */
 int co_mgr_lss_init(struct co_mgr *m);
 
+/* --- mgr_pgm.c: program download in the software step --------------------------------------- */
+
+/* Boot handler results besides a next step (mgr_boot.c). */
+#define CO_MGR_NEXT_WAIT 0xfeU
+#define CO_MGR_NEXT_END  0xfdU
+
+/* mgr_boot.c's transfer helpers and result, for the steps of mgr_pgm.c. */
+uint8_t co_mgr_boot_fail(struct co_mgr_slave *s, uint8_t status, uint16_t index, uint8_t sub,
+			 uint32_t expected, uint32_t actual, uint32_t abort_code);
+uint8_t co_mgr_boot_upload(struct co_mgr_slave *s, uint16_t index, uint8_t sub);
+void co_mgr_boot_sdo_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, void *user_data);
+
+/* Whether the application has an image for the slave (then its download starts). */
+bool co_mgr_pgm_has_image(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_stop(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_stop_sdo(struct co_mgr_slave *s, uint32_t ab);
+uint8_t co_mgr_pgm_download(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_download_sdo(struct co_mgr_slave *s, uint32_t ab);
+uint8_t co_mgr_pgm_start(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_start_sdo(struct co_mgr_slave *s, uint32_t ab);
+uint8_t co_mgr_pgm_restart(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_restart_ec(struct co_mgr_slave *s, uint8_t byte);
+uint8_t co_mgr_pgm_restart_to(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_date(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_date_sdo(struct co_mgr_slave *s, uint32_t ab);
+uint8_t co_mgr_pgm_time(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_time_sdo(struct co_mgr_slave *s, uint32_t ab);
+uint8_t co_mgr_pgm_resume(struct co_mgr_slave *s);
+uint8_t co_mgr_pgm_resume_sdo(struct co_mgr_slave *s, uint32_t ab);
+
 #endif /* SAFELINE_SUBSYS_CANOPEN_MGR_MGR_INTERNAL_H_ */
