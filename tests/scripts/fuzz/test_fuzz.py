@@ -106,3 +106,20 @@ def test_eds2od_harness_flags_an_exception(tmp_path, monkeypatch):
     monkeypatch.setattr(fuzz_eds2od, "eds2od_main", broken)
     seed = os.path.join(EDS_HARNESS_DIR, "corpus", "lss.eds")
     assert fuzz_eds2od.check(seed, str(tmp_path)).startswith("Traceback")
+
+
+@pytest.mark.parametrize("name", ["canopen-log-no-deviceinfo.eds",
+                                  "canopen-error-multiline.eds"])
+def test_eds2od_names_the_file_on_every_line_of_python_canopen_messages(name, tmp_path):
+    """Found by the eds2od harness: python-canopen's log line (no [DeviceInfo]) came out bare,
+    and its exception text split one warning over several lines."""
+    src = os.path.join(EDS_HARNESS_DIR, "regressions", name)
+    path = tmp_path / name
+    path.write_bytes(open(src, "rb").read())
+    r = subprocess.run([sys.executable, os.path.join(BASE, "scripts", "eds2od"), str(path),
+                        "-o", str(tmp_path / "out")], capture_output=True, text=True)
+    assert r.returncode in (0, 1)
+    lines = r.stderr.splitlines()
+    assert any("python-canopen" in line for line in lines), r.stderr
+    for line in lines:
+        assert line.startswith(f"{path}:") or line.startswith("eds2od: "), line
