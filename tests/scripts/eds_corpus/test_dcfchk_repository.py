@@ -4,7 +4,8 @@
 
 A DCF is checked with its own NodeID, an EDS with node-ID 1 (dcfchk needs one to evaluate
 $NODEID COB-IDs of PDOs). Left out: tests/scripts/eds_corpus/, whose files are quirks on
-purpose or other projects' files (third_party/SOURCES.md). SafeLine's own keys are written as
+purpose or other projects' files (third_party/SOURCES.md), and the fuzzer's regression inputs
+(tests/fuzz/eds2od/regressions/, malformed on purpose). SafeLine's own keys are written as
 comments there (";SafeLineSize=64"), which dcfchk skips and eds2od reads (doc/eds2od.md).
 """
 
@@ -30,8 +31,8 @@ def repository_files():
                       if n.endswith((".eds", ".dcf"))]
     else:
         files = r.stdout.split()
-    return sorted(f for f in files if not f.startswith("tests/scripts/eds_corpus/")
-                  and not f.startswith("build/"))
+    skip = ("tests/scripts/eds_corpus/", "tests/fuzz/eds2od/regressions/", "build/")
+    return sorted(f for f in files if not f.startswith(skip))
 
 
 FILES = repository_files()
