@@ -32,6 +32,7 @@
 #include <zephyr/kernel.h>
 #include <zephyr/sys/util.h>
 
+#include <can_socketcan.h>
 #include <can_virtual.h>
 #include <canopen/errctl.h>
 #include <canopen/line.h>
@@ -41,20 +42,22 @@
 #include <canopen/redundancy.h>
 
 #include "cmdline.h"
+#include "link.h"
 #include "posix_native_task.h"
 #include "rdn_master_od.h"
 #include "rdn_slave_od.h"
 
-#define N_UNITS     4
-#define N_SLAVES    (N_UNITS - 1)
-#define MASTER_ID   1U
-#define IDX_HB_CONS 0x1016U
-#define IDX_HB_PROD 0x1017U
-#define IDX_COUNTER 0x2000U /* slave: the counter TPDO 1 carries */
-#define IDX_COUNTS  0x2100U /* master: sub n = the counter of node n + 1 */
+#define N_UNITS        4
+#define N_SLAVES       (N_UNITS - 1)
+#define MASTER_ID      1U
+#define IDX_HB_CONS    0x1016U
+#define IDX_HB_PROD    0x1017U
+#define IDX_COUNTER    0x2000U /* slave: the counter TPDO 1 carries */
+#define IDX_TPDO1_COMM 0x1800U
+#define IDX_COUNTS     0x2100U /* master: sub n = the counter of node n + 1 */
 /* Values a run may produce per slave (100 per second: almost three hours). */
-#define MAX_VALUES  (1U << 20)
-#define WAIT_MS     3000
+#define MAX_VALUES     (1U << 20)
+#define WAIT_MS        3000
 
 /* --- Options -------------------------------------------------------------------------------- */
 
@@ -64,12 +67,14 @@ static struct {
 	double pause_s;
 	uint32_t hb_ms;
 	uint32_t consumer_ms;
+	uint32_t pdo_ms;
 } opt = {
 	.settle_s = 0.5,
 	.cut_s = 1.0,
 	.pause_s = 1.0,
 	.hb_ms = 0U,       /* 0: the dictionaries' 1017h */
 	.consumer_ms = 0U, /* 0: the dictionaries' 1016h */
+	.pdo_ms = 0U,      /* 0: the slaves' 1800h:05 */
 };
 
 static void settle_found(char *argv, int offset)
@@ -95,6 +100,11 @@ static void hb_found(char *argv, int offset)
 static void consumer_found(char *argv, int offset)
 {
 	opt.consumer_ms = (uint32_t)cmd_read_uint_option("hb-consumer", &argv[offset], 1U, 65535U);
+}
+
+static void pdo_found(char *argv, int offset)
+{
+	opt.pdo_ms = (uint32_t)cmd_read_uint_option("pdo-ms", &argv[offset], 1U, 65535U);
 }
 
 static void add_options(void)
@@ -137,6 +147,14 @@ static void add_options(void)
 			.call_when_found = consumer_found,
 			.descript = "heartbeat consumer time of every 1016h entry (default: the "
 				    "dictionaries', 125)",
+		},
+		{
+			.option = "pdo-ms",
+			.name = "ms",
+			.type = 'u',
+			.call_when_found = pdo_found,
+			.descript = "period of each slave's counter TPDO, 1800h:05 (default: the "
+				    "dictionary's, 10)",
 		},
 		ARG_TABLE_ENDMARKER,
 	};
@@ -287,7 +305,7 @@ static uint32_t get_u32(struct unit *u, uint16_t index, uint8_t sub)
 	return v;
 }
 
-/* The heartbeat timings of the options, before the line choice starts counting. */
+/* The timings of the options, before the line choice starts counting. */
 static int apply_timings(struct unit *u)
 {
 	int err = 0;
@@ -306,6 +324,14 @@ static int apply_timings(struct unit *u)
 
 		err = set_u32(u, IDX_HB_CONS, sub, (e & 0xFFFF0000U) | opt.consumer_ms);
 	}
+	if (err == 0 && opt.pdo_ms != 0U && u != MASTER) {
+		co_node_lock(&u->node);
+		if (co_od_set_u16(co_node_od(&u->node), IDX_TPDO1_COMM, 5, (uint16_t)opt.pdo_ms,
+				  CO_OD_WRITER_APP) != 0U) {
+			err = -EIO;
+		}
+		co_node_unlock(&u->node);
+	}
 	return err;
 }
 
@@ -320,9 +346,18 @@ static int unit_start(struct unit *u, int index)
 	for (int l = 0; l < (int)CO_NODE_LINES && err == 0; l++) {
 		char dev_name[16];
 
-		/* Controller 2i is on bus 0 (default line), 2i + 1 on bus 1 (redundant line). */
-		(void)snprintf(dev_name, sizeof(dev_name), "can_virtual%d", 2 * index + l);
+		/*
+		 * Controller 2i is the node's default line, 2i + 1 its redundant line: SocketCAN
+		 * when it has an interface (--can-if=0:vcan0 --can-if=1:vcan1 put every even
+		 * controller on vcan0 and every odd one on vcan1, CONFIG_CAN_SOCKETCAN_IFNAMES),
+		 * else virtual bus 0 and bus 1.
+		 */
+		(void)snprintf(dev_name, sizeof(dev_name), "can_socketcan%d", 2 * index + l);
 		u->can[l] = device_get_binding(dev_name);
+		if (u->can[l] == NULL || !device_is_ready(u->can[l])) {
+			(void)snprintf(dev_name, sizeof(dev_name), "can_virtual%d", 2 * index + l);
+			u->can[l] = device_get_binding(dev_name);
+		}
 		err = u->can[l] == NULL
 			      ? -ENODEV
 			      : co_line_init(&u->line[l], line_names[index][l], u->can[l]);
@@ -501,20 +536,60 @@ static void nmt_send(uint8_t cs, uint8_t id)
 	co_node_unlock(&MASTER->node);
 }
 
-/* Cut or restore line @p l of every node (every controller of bus @p l). */
-static void line_fault(int l, bool cut, const char *what)
+/* The SocketCAN interface of line @p l, NULL when it is on the virtual bus. */
+static const char *line_ifname(int l)
 {
-	uint64_t now = co_line_now();
+	return can_socketcan_ifname(units[0].can[l]);
+}
 
-	fault.what = what;
-	fault.at_us = now;
-	memset(fault.switched_us, 0, sizeof(fault.switched_us));
-	printk("redundant_network: %s %s line (bus %d)\n", cut ? "cutting the" : "restoring the",
-	       line_word[l], can_virtual_get_bus(units[0].can[l]));
-	for (int i = 0; i < N_UNITS; i++) {
-		(void)(cut ? can_virtual_cut(units[i].can[l])
-			   : can_virtual_restore(units[i].can[l]));
+/* "bus 0" or "vcan0": where line @p l is. */
+static const char *line_where(int l, char *buf, size_t size)
+{
+	const char *ifname = line_ifname(l);
+
+	if (ifname != NULL) {
+		return ifname;
 	}
+	(void)snprintf(buf, size, "bus %d", can_virtual_get_bus(units[0].can[l]));
+	return buf;
+}
+
+/*
+ * Cut or restore line @p l of every node: every controller of virtual bus @p l, or the
+ * SocketCAN interface itself (down/up as ip link set does: every socket on it, ours and any
+ * other program's, loses the bus; needs root, e.g. inside scripts/vcan-vm).
+ */
+static int line_fault(int l, bool cut, const char *what)
+{
+	const char *ifname = line_ifname(l);
+	char where[16];
+
+	memset(fault.switched_us, 0, sizeof(fault.switched_us));
+	fault.what = what;
+	if (ifname == NULL) {
+		fault.at_us = co_line_now();
+		printk("redundant_network: %s %s line (%s)\n",
+		       cut ? "cutting the" : "restoring the", line_word[l],
+		       line_where(l, where, sizeof(where)));
+		for (int i = 0; i < N_UNITS; i++) {
+			(void)(cut ? can_virtual_cut(units[i].can[l])
+				   : can_virtual_restore(units[i].can[l]));
+		}
+		return 0;
+	}
+
+	int rc = link_set(ifname, !cut);
+
+	fault.at_us = co_line_now();
+	printk("redundant_network: %s %s line (%s, as ip link set %s %s)\n",
+	       cut ? "cutting the" : "restoring the", line_word[l], ifname, ifname,
+	       cut ? "down" : "up");
+	if (rc != 0) {
+		printk("redundant_network: FAILED: link %s %s: %d\n", ifname, cut ? "down" : "up",
+		       rc);
+		return 1;
+	}
+	return 0;
 }
 
 /*
@@ -635,7 +710,10 @@ int main(void)
 {
 	uint32_t hb_ms, consumer_ms, bound_ms;
 	uint16_t hb16 = 0U;
+	uint16_t pdo16 = 0U;
 	int failures = 0;
+	char w0[16];
+	char w1[16];
 
 	for (int i = 0; i < N_UNITS; i++) {
 		if (unit_start(&units[i], i) != 0) {
@@ -648,10 +726,10 @@ int main(void)
 	hb_ms = hb16;
 	consumer_ms = get_u32(MASTER, IDX_HB_CONS, 1) & 0xFFFFU;
 	bound_ms = consumer_ms + hb_ms;
-	printk("redundant_network: master (node 1) and nodes 2-4 on two lines each: %s/%s on bus "
-	       "%d (default), %s/%s on bus %d (redundant)\n",
-	       units[0].can[0]->name, units[0].can[1]->name, can_virtual_get_bus(units[0].can[0]),
-	       units[3].can[0]->name, units[3].can[1]->name, can_virtual_get_bus(units[0].can[1]));
+	printk("redundant_network: master (node 1) and nodes 2-4 on two lines each: %s/%s on %s "
+	       "(default), %s/%s on %s (redundant)\n",
+	       units[0].can[0]->name, units[3].can[0]->name, line_where(0, w0, sizeof(w0)),
+	       units[0].can[1]->name, units[3].can[1]->name, line_where(1, w1, sizeof(w1)));
 	printk("redundant_network: heartbeat %u ms, consumer time %u ms: a switch is due within "
 	       "%u ms of a cut\n",
 	       hb_ms, consumer_ms, bound_ms);
@@ -673,7 +751,10 @@ int main(void)
 		}
 		run_until(k_uptime_get() + 10);
 	}
-	printk("master: nodes 2-4 OPERATIONAL, counters every 10 ms on both lines\n");
+	co_node_lock(&units[1].node);
+	(void)co_od_get_u16(co_node_od(&units[1].node), IDX_TPDO1_COMM, 5, &pdo16);
+	co_node_unlock(&units[1].node);
+	printk("master: nodes 2-4 OPERATIONAL, counters every %u ms on both lines\n", pdo16);
 	run_for(opt.settle_s);
 
 	/*
@@ -683,19 +764,19 @@ int main(void)
 	 * (the heartbeats a cut controller held back count once): two to five periods after a
 	 * restore.
 	 */
-	line_fault(CO_LINE_DEFAULT, true, "the cut");
+	failures += line_fault(CO_LINE_DEFAULT, true, "the cut");
 	run_for(opt.cut_s);
 	failures += check_switches(CO_LINE_REDUNDANT, consumer_ms - hb_ms, bound_ms);
 
-	line_fault(CO_LINE_DEFAULT, false, "the restore");
+	failures += line_fault(CO_LINE_DEFAULT, false, "the restore");
 	run_for(opt.pause_s);
 	failures += check_switches(CO_LINE_DEFAULT, 2U * hb_ms, 5U * hb_ms);
 
-	line_fault(CO_LINE_REDUNDANT, true, "the cut of the redundant line");
+	failures += line_fault(CO_LINE_REDUNDANT, true, "the cut of the redundant line");
 	run_for(opt.cut_s);
 	failures += check_switches(CO_LINE_DEFAULT, 0U, 0U);
 
-	line_fault(CO_LINE_REDUNDANT, false, "the restore of the redundant line");
+	failures += line_fault(CO_LINE_REDUNDANT, false, "the restore of the redundant line");
 	run_for(opt.pause_s);
 	failures += check_switches(CO_LINE_DEFAULT, 0U, 0U);
 
