@@ -162,7 +162,9 @@ struct co_rpdo {
 };
 
 struct co_tpdo {
-	struct co_rx rx;               /* remote requests */
+#if defined(CONFIG_CANOPEN_PDO_RTR)
+	struct co_rx rx; /* remote requests */
+#endif
 	struct co_timer inhibit_timer; /* end of the inhibit time */
 	struct co_timer event_timer;   /* event timer, 1800h sub 5 */
 	struct co_pdo_map map;

@@ -559,6 +559,7 @@ static void tpdo_event_expired(struct co_timer *timer, uint64_t now_us)
 	}
 }
 
+#if defined(CONFIG_CANOPEN_PDO_RTR)
 static void tpdo_rtr(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
 {
 	struct co_tpdo *t = rx->user_data;
@@ -582,6 +583,7 @@ static void tpdo_rtr(struct co_rx *rx, const struct can_frame *frame, uint64_t n
 		break;
 	}
 }
+#endif /* CONFIG_CANOPEN_PDO_RTR */
 
 static void tpdo_reset_state(struct co_tpdo *t)
 {
@@ -600,17 +602,21 @@ static void tpdo_configure(struct co_tpdo *t)
 	struct co_node *node = t->node;
 
 	tpdo_reset_state(t);
+#if defined(CONFIG_CANOPEN_PDO_RTR)
 	co_rx_unregister(&t->rx);
+#endif
 	if (!cob_valid(t->cob_id)) {
 		return;
 	}
-	if (IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) && (t->cob_id & CO_PDO_COB_NO_RTR) == 0U) {
+#if defined(CONFIG_CANOPEN_PDO_RTR)
+	if ((t->cob_id & CO_PDO_COB_NO_RTR) == 0U) {
 		t->rx.ext = (t->cob_id & CO_PDO_COB_FRAME) != 0U;
 		t->rx.mask = t->rx.ext ? CAN_ID_EXT : CAN_ID_STD;
 		if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &t->rx, cob_can_id(t->cob_id)) != 0) {
 			LOG_ERR("%s: no receive slot for TPDO %u RTR", node->name, t->num);
 		}
 	}
+#endif
 	tpdo_event_timer_restart(t, co_node_time(node));
 }
 
@@ -1036,7 +1042,9 @@ static int pdo_init(struct co_node *node)
 		t->num = i;
 		t->present = od_has(node, IDX_TPDO_COMM + i) && od_has(node, IDX_TPDO_MAP + i);
 		t->cob_id = CO_PDO_COB_INVALID;
+#if defined(CONFIG_CANOPEN_PDO_RTR)
 		co_rx_init(&t->rx, 0U, tpdo_rtr, &node->lock, t);
+#endif
 		co_timer_init(&t->inhibit_timer, tpdo_inhibit_expired, &node->lock, t);
 		co_timer_init(&t->event_timer, tpdo_event_expired, &node->lock, t);
 	}

@@ -175,6 +175,13 @@ static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool
 	return true;
 }
 
+/*
+ * Without bit-wise mapping co_pdo_map_check() lets through whole objects in whole bytes and
+ * (RPDOs) dummies only: the per-bit and part-of-an-object paths below cannot be taken, and
+ * leaving them out of such a build saves their code.
+ */
+#define BITWISE IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
+
 uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8])
 {
 	uint8_t val[8];
@@ -185,7 +192,7 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 		struct co_pdo_map_ent *ent = &map->ent[i];
 		size_t len;
 
-		if (map->bytewise && ent->whole) {
+		if (!BITWISE || (map->bytewise && ent->whole)) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
 			if (co_od_read_cached(od, &ent->info, &ent->cover, &data[off / 8U],
 					      ent->bits / 8U, &len, CO_OD_WRITER_PDO) != 0U) {
@@ -215,11 +222,11 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 	for (uint8_t i = from; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
 
-		if (map->bytewise && ent->whole) {
+		if (BITWISE ? map->bytewise && ent->whole : !co_pdo_ent_is_dummy(ent)) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
 			refused += co_od_write_cached(od, &ent->info, &ent->cover, &data[off],
 						      ent->bits / 8U, CO_OD_WRITER_PDO) != 0U;
-		} else if (!co_pdo_ent_is_dummy(ent)) {
+		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));
 			if (map->bytewise) {
 				memcpy(val, &data[off], ent->bits / 8U);

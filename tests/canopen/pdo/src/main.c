@@ -669,6 +669,9 @@ ZTEST(co_pdo, test_tpdo_rtr)
 {
 	const uint32_t map[] = {0x20000108};
 
+	if (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR)) {
+		ztest_test_skip();
+	}
 	setup_pdo(false, 1, 0x2A1, 253, map, 1);
 	setup_pdo(false, 2, 0x3A1, 252, map, 1);
 	go_operational();
@@ -706,6 +709,29 @@ ZTEST(co_pdo, test_tpdo_rtr)
 	zassert_equal(co_sim_write(&t.node, 0x1800, 2, 255, 1), 0U);
 	rx_rtr(0x180 + NODE_ID, 0);
 	zassert_equal(count(0x180 + NODE_ID), 1, "an RTR is an event for 254/255");
+}
+
+/* CONFIG_CANOPEN_PDO_RTR=n (scenario canopen.pdo.no_rtr): no receiver for remote frames. */
+ZTEST(co_pdo, test_tpdo_rtr_disabled)
+{
+	const uint32_t map[] = {0x20000108};
+
+	if (IS_ENABLED(CONFIG_CANOPEN_PDO_RTR)) {
+		ztest_test_skip();
+	}
+	setup_pdo(false, 1, 0x2A1, 254, map, 1);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 2, 253, 1), CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(co_sim_write(&t.node, 0x1801, 2, 252, 1), CO_SDO_AB_INVALID_VALUE);
+	go_operational();
+	co_sim_run_until(10 * MS);
+	int before_rtr = count(0x2A1);
+
+	rx_rtr(0x2A1, 1);
+	co_sim_run_until(20 * MS);
+	zassert_equal(count(0x2A1), before_rtr, "a remote frame is not an event without RTR");
+	app_u8(0x2000, 1, 0x33);
+	co_sim_run_until(30 * MS);
+	zassert_equal(count(0x2A1), before_rtr + 1, "a change of state still is");
 }
 
 ZTEST(co_pdo, test_nmt_gating)
