@@ -32,6 +32,7 @@
 #include <canopen/nmt.h>
 #include <canopen/node.h>
 #include <canopen/od.h>
+#include <canopen/redundancy.h>
 #if defined(CONFIG_CANOPEN_MGR)
 #include <canopen/mgr.h>
 #endif
@@ -70,6 +71,7 @@ enum br_ev_kind {
 	BR_EV_SRDO,
 	BR_EV_SNAPSHOT,
 	BR_EV_WAKE,
+	BR_EV_ACTIVE,
 };
 
 struct br_event {
@@ -88,6 +90,10 @@ struct br_event {
 			uint8_t what;
 			uint8_t state;
 		} hb;
+		struct {
+			/* The node's active line (enum co_node_line_id). */
+			uint8_t line;
+		} active;
 		struct {
 			bool lost;
 		} life;
@@ -157,6 +163,26 @@ static void post(const struct br_event *e)
 	atomic_max(&br.queue_max, (atomic_val_t)k_msgq_num_used_get(&br_queue));
 }
 
+/* The active line of bridged node @p b, for both lines it is on (CiA 302-6). */
+static void post_active(const struct br_bnode *b, uint8_t line, uint64_t time_us)
+{
+	for (int i = 0; i < (int)CO_NODE_LINES; i++) {
+		struct br_event e = {
+			.kind = BR_EV_ACTIVE,
+			.slot = b->slot[i],
+			.src = b->idx,
+			.node_id = b->node_id,
+			.time_us = time_us,
+			.active = {.line = line},
+		};
+
+		if (b->slot[i] != BR_NO_LINE &&
+		    (i == (int)CO_LINE_DEFAULT || b->slot[i] != b->slot[CO_LINE_DEFAULT])) {
+			post(&e);
+		}
+	}
+}
+
 /* Node events (line thread or the API caller, node lock held). */
 static int on_event(struct co_node *node, const struct co_event *ev, void *user_data)
 {
@@ -174,9 +200,16 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 	e.time_us = co_node_time(node);
 	switch (ev->type) {
 	case CO_EV_NMT_STATE:
+		/* A reset chose the default line again without a switch event. */
+		post_active(b, co_node_active_line(node), e.time_us);
 		e.kind = BR_EV_NMT;
 		e.nmt.state = (uint8_t)ev->nmt.to;
 		break;
+	case CO_EV_REDUNDANCY:
+		if (ev->redundancy.what == CO_RDN_EV_SWITCH) {
+			post_active(b, ev->redundancy.line, e.time_us);
+		}
+		return 0;
 	case CO_EV_HB:
 		e.kind = BR_EV_HB;
 		e.node_id = ev->hb.node_id;
@@ -248,7 +281,7 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 #define EVENT_MASK                                                                                 \
 	(CO_EV_BIT(CO_EV_NMT_STATE) | CO_EV_BIT(CO_EV_HB) | CO_EV_BIT(CO_EV_LIFE) |                \
 	 CO_EV_BIT(CO_EV_ERROR) | CO_EV_BIT(CO_EV_EMCY) | CO_EV_BIT(CO_EV_LINE) |                  \
-	 CO_EV_BIT(CO_EV_BOOT) | CO_EV_BIT(CO_EV_SRDO))
+	 CO_EV_BIT(CO_EV_BOOT) | CO_EV_BIT(CO_EV_SRDO) | CO_EV_BIT(CO_EV_REDUNDANCY))
 
 /*
  * Heartbeats, boot-ups and node-guarding replies (700h + node-ID), line thread, no lock: the
@@ -428,6 +461,7 @@ static void publish_line(int slot)
 		.can_state = l->can_state,
 		.tx_err_cnt = l->tec,
 		.rx_err_cnt = l->rec,
+		.active_line = l->active_line,
 		.rx_frames = l->stats.rx_frames,
 		.tx_frames = l->stats.tx_frames,
 		.rx_overruns = l->stats.rx_overruns,
@@ -777,6 +811,12 @@ static void apply(const struct br_event *e)
 		break;
 	case BR_EV_LINE:
 		apply_line_event(&br.lines[slot], e);
+		break;
+	case BR_EV_ACTIVE:
+		if (br.lines[slot].active_line != e->active.line) {
+			br.lines[slot].active_line = e->active.line;
+			br.lines[slot].dirty = true;
+		}
 		break;
 	case BR_EV_BOOT:
 		n = touch(slot, e->node_id, t);

@@ -192,6 +192,8 @@ struct br_line {
 	uint8_t can_state;
 	uint8_t tec;
 	uint8_t rec;
+	/* CiA 302-6: the active line of the bridged nodes on this line (the last to change). */
+	uint8_t active_line;
 	bool dirty;
 	struct co_line_stats stats;
 	uint32_t nodes;

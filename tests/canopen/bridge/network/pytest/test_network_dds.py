@@ -123,6 +123,24 @@ def test_can_controller_state(net):
     until(lambda: c.lines()[0].can_state == 0, 3, "error-active again")
 
 
+def test_active_line_follows_the_redundancy_switch(net, client):
+    fw, c = net
+    assert [ln.active_line for ln in c.lines()] == [0, 0]
+    fw.send("switch 0 1")
+    until(lambda: c.lines()[0].active_line == 1, 3, "line 0: redundant line active")
+    assert c.lines()[1].active_line == 0, "the other gateway did not switch"
+    fw.send("switch 0 0")
+    until(lambda: c.lines()[0].active_line == 0, 3, "line 0: default line active again")
+    # A reset picks the default line without a switch event: an NMT state change re-reads
+    # the node's own view (this gateway has one line, so the default).
+    fw.send("switch 0 1")
+    until(lambda: c.lines()[0].active_line == 1, 3, "switched again")
+    ops = client("ops")
+    assert ops.nmt(1, NMT_PREOP).status == T.STATUS_OK
+    until(lambda: c.lines()[0].active_line == 0, 3, "the node's own active line after NMT")
+    assert ops.nmt(1, NMT_START).status == T.STATUS_OK
+
+
 def stats(fw):
     """The bridge's counters as the image prints them (exact, at once)."""
     n = len(re.findall(r"^stats ", fw.text(), re.M))

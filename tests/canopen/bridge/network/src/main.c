@@ -13,6 +13,8 @@
  * "error <command>: reason") once done:
  *   emcy LINE CODE | clear LINE CODE   the device of LINE raises / clears an EMCY
  *   srdo LINE N SAFE REASON            the gateway of LINE publishes an SRDO event
+ *   switch LINE TO                     the gateway of LINE publishes a CiA 302-6 line switch
+ *                                      to its line TO (0 default, 1 redundant)
  *   burst N                            N events on gateway 0 as fast as they can be raised
  *   canstate LINE STATE                the gateway's controller enters enum can_state STATE
  *   count LINE VALUE                   the gateway's 2000h := VALUE (a local object value)
@@ -42,6 +44,7 @@
 #include <canopen/nmt.h>
 #include <canopen/node.h>
 #include <canopen/od.h>
+#include <canopen/redundancy.h>
 
 #include "bridge_test_od.h"
 #include "cmdline.h"
@@ -196,6 +199,25 @@ static int cmd_srdo(int line, int srdo, int safe, int reason)
 	return 0;
 }
 
+/* What the redundancy service publishes when it switches (these gateways have one line). */
+static int cmd_switch(int line, int to)
+{
+	struct co_event ev = {
+		.type = CO_EV_REDUNDANCY,
+		.redundancy = {.what = CO_RDN_EV_SWITCH,
+			       .line = (uint8_t)to,
+			       .time_us = co_line_now()},
+	};
+
+	if (to != CO_LINE_DEFAULT && to != CO_LINE_REDUNDANT) {
+		return -EINVAL;
+	}
+	co_node_lock(&gw[line].node);
+	(void)co_node_publish(&gw[line].node, &ev, NULL);
+	co_node_unlock(&gw[line].node);
+	return 0;
+}
+
 static int cmd_burst(int n)
 {
 	struct co_event ev = {
@@ -278,7 +300,7 @@ static int run(char *line)
 	if ((a < 0 || a >= LINES) &&
 	    (strcmp(cmd, "emcy") == 0 || strcmp(cmd, "clear") == 0 || strcmp(cmd, "srdo") == 0 ||
 	     strcmp(cmd, "canstate") == 0 || strcmp(cmd, "count") == 0 || strcmp(cmd, "cut") == 0 ||
-	     strcmp(cmd, "restore") == 0)) {
+	     strcmp(cmd, "restore") == 0 || strcmp(cmd, "switch") == 0)) {
 		return -EINVAL;
 	}
 	if (strcmp(cmd, "emcy") == 0 && n == 3) {
@@ -289,6 +311,9 @@ static int run(char *line)
 	}
 	if (strcmp(cmd, "srdo") == 0 && n == 5) {
 		return cmd_srdo((int)a, (int)b, (int)c, (int)d);
+	}
+	if (strcmp(cmd, "switch") == 0 && n == 3) {
+		return cmd_switch((int)a, (int)b);
 	}
 	if (strcmp(cmd, "burst") == 0 && n == 2) {
 		return cmd_burst((int)a);
