@@ -850,11 +850,13 @@ static inline void co_od_le_put(uint8_t *p, size_t len, uint64_t v)
 	}
 }
 
-/** @brief The new value of an integer write as unsigned (UINT, BOOL, TIME classes). */
-static inline uint64_t co_od_req_uint(const struct co_od_req *req)
-{
-	return co_od_le_get(req->data, req->len > 8 ? 8 : req->len);
-}
+/**
+ * @brief The new value of an integer write as unsigned (UINT, BOOL, TIME classes).
+ *
+ * Out of line: every service's validate hooks call it, and a size build would keep a copy
+ * in each of them.
+ */
+uint64_t co_od_req_uint(const struct co_od_req *req);
 /** @} */
 
 /**

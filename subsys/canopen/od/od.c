@@ -1735,6 +1735,11 @@ uint32_t co_od_set_time(struct co_od *od, uint16_t index, uint8_t sub, const str
 	return co_od_write_info(od, &info, wire, 6, writer);
 }
 
+uint64_t co_od_req_uint(const struct co_od_req *req)
+{
+	return co_od_le_get(req->data, req->len > 8 ? 8 : req->len);
+}
+
 uint32_t co_od_uint(const struct co_od *od, uint16_t index, uint8_t sub, uint32_t dflt)
 {
 	uint8_t wire[8] = {0};
