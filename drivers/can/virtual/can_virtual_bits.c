@@ -47,7 +47,7 @@ static void put_bit(struct bitseq *s, uint8_t bit, bool crc)
 	if (s->run == 5U) {
 		/* The stuff bit is the complement and starts a new run. */
 		s->stuffed++;
-		s->last = (uint8_t)!bit;
+		s->last = (bit != 0U) ? 0U : 1U;
 		s->run = 1U;
 	}
 }

@@ -207,7 +207,7 @@ static void put_sub(struct eds_out *o, const struct co_od_def *def, const struct
 	putf(o, "\nObjectType=0x%X\n", top ? e->objcode : 0x7U);
 	putf(o, "DataType=0x%04X\nAccessType=%s\n", d->dtype,
 	     d->access < 6U ? access_names[d->access] : "ro");
-	if (d->flags & CO_OD_F_DEFAULT) {
+	if ((d->flags & CO_OD_F_DEFAULT) != 0U) {
 		const struct co_od_nodeid *n = co_od_nodeid_of(def, pos);
 
 		puts_(o, "DefaultValue=");
@@ -219,21 +219,21 @@ static void put_sub(struct eds_out *o, const struct co_od_def *def, const struct
 		puts_(o, "\n");
 	}
 	putf(o, "PDOMapping=%u\n", (d->flags & CO_OD_F_MAP) ? 1U : 0U);
-	if (d->flags & CO_OD_F_LIMITS) {
+	if ((d->flags & CO_OD_F_LIMITS) != 0U) {
 		const struct co_od_limit *l = &def->limits[d->limit];
 
-		if (l->rel & CO_OD_LIM_LO_GIVEN) {
+		if ((l->rel & CO_OD_LIM_LO_GIVEN) != 0U) {
 			puts_(o, "LowLimit=");
-			if (l->rel & CO_OD_LIM_LO_REL) {
+			if ((l->rel & CO_OD_LIM_LO_REL) != 0U) {
 				put_rel(o, d->dtype, l->lo.i);
 			} else {
 				put_num(o, d->dtype, l->lo);
 			}
 			puts_(o, "\n");
 		}
-		if (l->rel & CO_OD_LIM_HI_GIVEN) {
+		if ((l->rel & CO_OD_LIM_HI_GIVEN) != 0U) {
 			puts_(o, "HighLimit=");
-			if (l->rel & CO_OD_LIM_HI_REL) {
+			if ((l->rel & CO_OD_LIM_HI_REL) != 0U) {
 				put_rel(o, d->dtype, l->hi.i);
 			} else {
 				put_num(o, d->dtype, l->hi);

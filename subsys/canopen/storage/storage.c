@@ -72,7 +72,9 @@ static int slot_check(struct co_storage *st, int slot, uint32_t *seq, uint32_t *
 	}
 	uint32_t crc = crc32_update(0xFFFFFFFFU, hdr + 4, 8);
 
-	for (uint32_t pos = 0; pos < *len;) {
+	uint32_t pos = 0U;
+
+	while (pos < *len) {
 		size_t n = *len - pos < sizeof(st->buf) ? *len - pos : sizeof(st->buf);
 
 		err = be_read(st, base + SLOT_HDR + pos, st->buf, n);
@@ -164,7 +166,9 @@ static uint32_t group_records(struct co_storage *st, uint8_t group, struct img *
 			hdr[3] = co_od_is_nodeid_default(st->od, &info) ? REC_F_NODEID : 0U;
 			co_od_le_put(hdr + 4, 2, len);
 			img_put(w, hdr, sizeof(hdr));
-			for (uint32_t off = 0; off < len;) {
+			uint32_t off = 0U;
+
+			while (off < len) {
 				size_t n;
 
 				(void)co_od_read_info(st->od, &info, off, st->buf, sizeof(st->buf),
@@ -224,10 +228,10 @@ static int write_image(struct co_storage *st, uint32_t save_mask, uint32_t drop_
 
 	for (uint8_t g = 1; g < CO_OD_GROUP_COUNT; g++) {
 		keep[g] = -1;
-		if (save_mask & CO_OD_GROUP_BIT(g)) {
+		if ((save_mask & CO_OD_GROUP_BIT(g)) != 0U) {
 			size[g] = group_records(st, g, NULL);
 			total += BLOCK_HDR + size[g];
-		} else if (!(drop_mask & CO_OD_GROUP_BIT(g))) {
+		} else if ((drop_mask & CO_OD_GROUP_BIT(g)) == 0U) {
 			keep[g] = old_block(st, g, &size[g]);
 			if (keep[g] >= 0) {
 				total += BLOCK_HDR + size[g];
@@ -254,7 +258,7 @@ static int write_image(struct co_storage *st, uint32_t save_mask, uint32_t drop_
 	co_od_le_put(sl + 4, 4, total);
 	w.crc = crc32_update(0xFFFFFFFFU, sl, sizeof(sl));
 	for (uint8_t g = 1; g < CO_OD_GROUP_COUNT && w.err == 0; g++) {
-		bool fresh = save_mask & CO_OD_GROUP_BIT(g);
+		bool fresh = (save_mask & CO_OD_GROUP_BIT(g)) != 0U;
 
 		if (!fresh && keep[g] < 0) {
 			continue;
@@ -351,7 +355,9 @@ static void restore_record(struct co_storage *st, uint32_t at, const uint8_t *hd
 		st->skipped++;
 		return;
 	}
-	for (uint32_t off = 0; off < len;) {
+	uint32_t off = 0U;
+
+	while (off < len) {
 		size_t n = len - off < sizeof(st->buf) ? len - off : sizeof(st->buf);
 
 		if (be_read(st, at + off, st->buf, n) != 0 ||

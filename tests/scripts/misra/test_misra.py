@@ -45,8 +45,8 @@ uint32_t misra_probe(uint32_t v)
 """
 
 
-def run(*args, out):
-    return subprocess.run([sys.executable, SCRIPT, "--out", str(out), *args], cwd=BASE,
+def run(*args, out, cwd=BASE):
+    return subprocess.run([sys.executable, SCRIPT, "--out", str(out), *args], cwd=cwd,
                           capture_output=True, text=True)
 
 
@@ -69,7 +69,8 @@ def probe(tmp_path):
 
 
 def test_an_unlisted_violation_fails(probe, tmp_path):
-    r = run(str(probe), out=tmp_path / "out")
+    # From another folder: paths are the project's, not the caller's.
+    r = run(str(probe), out=tmp_path / "out", cwd=tmp_path)
     assert r.returncode == 1, r.stdout + r.stderr
     assert "rule 15.6: 1" in r.stdout
     assert f"{probe}:9:" in r.stdout and "(NOT DEVIATED)" in r.stdout
