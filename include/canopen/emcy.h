@@ -140,6 +140,17 @@ struct co_emcy {
 	struct co_rx cons_rx[CONFIG_CANOPEN_EMCY_CONSUMERS];
 	co_emcy_ind_t ind;
 	void *ind_user_data;
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	/* Two lines: the last EMCY frames taken, each matched once by its copy from the other. */
+	struct {
+		uint64_t at;
+		uint16_t id;
+		uint8_t data[8];
+		uint8_t line;
+		bool copied;
+	} taken[4];
+	uint8_t taken_next;
+#endif
 };
 /** @endcond */
 #endif

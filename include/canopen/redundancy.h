@@ -120,8 +120,9 @@ struct co_rdn_hb {
 };
 
 struct co_redundancy {
-	struct co_rx fwd;   /* every frame of the redundant line, handed to the node */
-	struct co_rx hb_rx; /* heartbeats of supervised nodes, on either line */
+	struct co_rx fwd;     /* every frame of the redundant line, handed to the node */
+	struct co_rx fwd_ext; /* the same for 29-bit frames */
+	struct co_rx hb_rx;   /* heartbeats of supervised nodes, on either line */
 	struct co_timer timer;
 	struct co_listener listener;
 	uint64_t eval_end;

@@ -7,9 +7,9 @@
  * Redundant CAN lines (CiA 302-6, with the ECSS-E-ST-50-15C toggle profile as an option).
  *
  * Decisions (doc/redundancy.md):
- * - The node hears both lines: one catch-all receiver on the redundant line hands its frames
- *   to the node's receivers of the default line (co_node_dispatch_from()), so no service needs
- *   a second set of receivers; services that care ask co_node_rx_line().
+ * - The node hears both lines: catch-all receivers on the redundant line (11- and 29-bit)
+ *   hand its frames to the node's receivers of the default line (co_node_dispatch_from()), so
+ *   no service needs a second set of receivers; services that care ask co_node_rx_line().
  * - Heartbeats of the nodes in 1016h are supervised per line with 1016h's consumer times, by
  *   one masked receiver for 701h-77Fh; the heartbeat consumer service keeps judging the node
  *   as a whole (heard on any line).
@@ -459,6 +459,9 @@ static int rdn_init(struct co_node *node)
 	memset(r, 0, sizeof(*r));
 	co_rx_init(&r->fwd, 0U, fwd_rx, &node->lock, node);
 	r->fwd.mask = 0U;
+	co_rx_init(&r->fwd_ext, 0U, fwd_rx, &node->lock, node);
+	r->fwd_ext.mask = 0U;
+	r->fwd_ext.ext = true;
 	co_rx_init(&r->hb_rx, HB_COB_BASE, hb_rx, &node->lock, node);
 	r->hb_rx.mask = 0x780U;
 	co_timer_init(&r->timer, timer_handler, &node->lock, node);
@@ -496,6 +499,7 @@ static void rdn_reset_comm(struct co_node *node)
 
 	co_timer_stop(&r->timer);
 	co_rx_unregister(&r->fwd);
+	co_rx_unregister(&r->fwd_ext);
 	co_rx_unregister(&r->hb_rx);
 	memset(r->hb, 0, sizeof(r->hb));
 	r->tpdo_max = (uint8_t)co_od_uint(&node->od, CO_RDN_IDX, CO_RDN_SUB_TPDO_MAX, 0U);
@@ -511,6 +515,7 @@ static void rdn_reset_comm(struct co_node *node)
 	supervised_read(node);
 	(void)co_node_set_process_route(node, ECSS ? CO_ROUTE_ACTIVE : CO_ROUTE_BOTH);
 	if (co_node_rx_register(node, CO_LINE_REDUNDANT, &r->fwd) != 0 ||
+	    co_node_rx_register(node, CO_LINE_REDUNDANT, &r->fwd_ext) != 0 ||
 	    co_node_rx_register(node, CO_LINE_DEFAULT, &r->hb_rx) != 0) {
 		LOG_ERR("%s: no receive slot for redundancy", node->name);
 	}

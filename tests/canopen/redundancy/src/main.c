@@ -16,6 +16,7 @@
 
 #include <zephyr/ztest.h>
 
+#include <canopen/emcy.h>
 #include <canopen/node.h>
 #include <canopen/pdo.h>
 #include <canopen/redundancy.h>
@@ -55,6 +56,11 @@ static struct {
 	int n_sync;
 	bool veto_refuses;
 	int veto_asked;
+	int n_emcy;
+	uint16_t emcy_code[8];
+	struct co_rx ext_rx;
+	int n_ext;
+	uint8_t ext_line[8];
 } t;
 
 static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
@@ -85,6 +91,19 @@ static bool veto(struct co_node *node, enum co_rdn_event why, uint8_t to, void *
 {
 	t.veto_asked++;
 	return !t.veto_refuses;
+}
+
+static void on_emcy(struct co_node *node, uint16_t cob_id, uint8_t remote_id, uint16_t code,
+		    uint8_t reg, const uint8_t msef[5], void *user_data)
+{
+	zassert_true(t.n_emcy < (int)ARRAY_SIZE(t.emcy_code));
+	t.emcy_code[t.n_emcy++] = code;
+}
+
+static void on_ext(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
+{
+	zassert_true(t.n_ext < (int)ARRAY_SIZE(t.ext_line));
+	t.ext_line[t.n_ext++] = co_node_rx_line(&t.node);
 }
 
 static void on_sync(struct co_node *node, uint8_t counter, void *user_data)
@@ -180,6 +199,7 @@ static void before(void *f)
 	zassert_ok(co_node_listener_add(&t.node, &t.listener));
 	co_redundancy_set_veto(&t.node, veto, NULL);
 	co_sync_set_ind(&t.node, on_sync, NULL);
+	co_emcy_set_ind(&t.node, on_emcy, NULL);
 	zassert_ok(co_node_start(&t.node));
 }
 
@@ -439,6 +459,59 @@ ZTEST(co_redundancy, test_queued_process_data_withdrawn_when_the_line_goes_error
 	run_until(t.now + 1 * MS);
 	zassert_equal(count_id(D, 0x181), 0, "none goes out stale");
 	zassert_equal(count_id(R, 0x181), 3);
+}
+
+/* --- What else each line brings ---------------------------------------------------------- */
+
+ZTEST(co_redundancy, test_emcy_copies_from_the_other_line_reach_the_consumer_once)
+{
+	const uint8_t e1[8] = {0x00, 0x50, 0x01, 1, 2, 3, 4, 5};
+	const uint8_t e2[8] = {0x00, 0x42, 0x09};
+
+	run_until(10 * MS);
+	rx(D, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	rx(R, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 1, "node 2's EMCY on both lines is one emergency");
+	/* The redundant line first works the same way. */
+	rx(R, 0x082, 8, e2);
+	rx(D, 0x082, 8, e2);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 2);
+	zassert_equal(t.emcy_code[1], 0x4200);
+	/* The same EMCY again on one line is a new emergency, and so is its copy's copy. */
+	rx(D, 0x082, 8, e1);
+	rx(D, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 4);
+	rx(R, 0x082, 8, e1);
+	rx(R, 0x082, 8, e1);
+	rx(R, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 5, "two copies, one new");
+	/* A copy later than the window is a new emergency (the PDO copies' limit too). */
+	rx(D, 0x082, 8, e2);
+	run_until(t.now + 60 * MS);
+	rx(R, 0x082, 8, e2);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 7);
+}
+
+ZTEST(co_redundancy, test_extended_frames_of_the_redundant_line_reach_the_node)
+{
+	struct can_frame f = {.id = 0x1234567, .dlc = 1, .flags = CAN_FRAME_IDE};
+
+	co_rx_init(&t.ext_rx, 0x1234567, on_ext, &t.node.lock, NULL);
+	t.ext_rx.ext = true;
+	zassert_ok(co_node_rx_register(&t.node, CO_LINE_DEFAULT, &t.ext_rx));
+	co_line_rx(&t.line[D], &f, t.now);
+	co_line_rx(&t.line[R], &f, t.now);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_ext, 2);
+	zassert_equal(t.ext_line[0], D);
+	zassert_equal(t.ext_line[1], R, "a 29-bit frame of the redundant line, handed over");
+	co_rx_unregister(&t.ext_rx);
 }
 
 /* --- 50: SDO server ------------------------------------------------------------------------- */
