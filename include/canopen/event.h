@@ -100,6 +100,12 @@ enum co_event_type {
 	 * found on one line, a line switch, a vetoed switch (@ref co_event.redundancy).
 	 */
 	CO_EV_REDUNDANCY,
+	/**
+	 * The flying master (CiA 302 §5.5) or the NMT master detection saw a change: this node
+	 * became the active master, another did, the active master was lost
+	 * (@ref co_event.fm).
+	 */
+	CO_EV_FM,
 	/** Number of event types. */
 	CO_EV_COUNT
 };
@@ -211,6 +217,17 @@ struct co_event {
 			/** When [µs, node time]. */
 			uint64_t time_us;
 		} redundancy;
+		/** CO_EV_FM. */
+		struct {
+			/** What happened (enum co_mgr_fm_event of canopen/mgr.h). */
+			uint8_t what;
+			/** The active master's node-ID (0 if none). */
+			uint8_t master_id;
+			/** Its priority (1F90h:03: 0 high, 1 medium, 2 low). */
+			uint8_t priority;
+			/** When [µs, node time]. */
+			uint64_t time_us;
+		} fm;
 		/** CO_EV_SRDO. */
 		struct {
 			/** SRDO number, 1..64; 0 for a received GFC (reason CO_SRDO_R_GFC). */

@@ -244,6 +244,91 @@ typedef int (*co_mgr_sw_ind_t)(struct co_node *node, uint8_t id, uint32_t exp_da
 			       uint32_t exp_time, uint32_t act_date, uint32_t act_time,
 			       void *user_data);
 
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+/**
+ * States of the flying master (CiA 302 §5.5, CiA 302-2 §3.7, §5) and of the NMT master
+ * detection of a self-starting device (CiA 302-2 §5.1), co_mgr_fm_get().
+ */
+enum co_mgr_fm_state {
+	/** Not a candidate (1F80h bits 0 and 5 not both set) and not self-starting (02h). */
+	CO_MGR_FM_OFF,
+	/** After the boot-up: waiting 1F90h:02 (negotiation time delay). */
+	CO_MGR_FM_DELAY,
+	/** 073h sent: waiting 1F90h:01 for an active master's 071h. */
+	CO_MGR_FM_DETECT,
+	/** 076h sent to a lower-priority active master: waiting for its reset. */
+	CO_MGR_FM_FORCED,
+	/** Negotiating: waiting priority x 1F90h:04 + node-ID x 1F90h:05 after the last 072h. */
+	CO_MGR_FM_NEGOTIATE,
+	/** This node is the active NMT master (the manager's functions run). */
+	CO_MGR_FM_ACTIVE,
+	/** Another node is the active master: this one is a slave and watches its heartbeat. */
+	CO_MGR_FM_SLAVE,
+	/** Self-starting device: waiting 1F91h:02 after the boot-up. */
+	CO_MGR_FM_SS_DELAY,
+	/** Self-starting device: 075h sent, waiting 1F91h:01 for a 074h. */
+	CO_MGR_FM_SS_ASK,
+	/** Self-starting device: nobody answered, waiting node-ID x 1F91h:03. */
+	CO_MGR_FM_SS_SLOT,
+	/** Self-starting device: the network was started, or a master-capable device exists. */
+	CO_MGR_FM_SS_DONE,
+	CO_MGR_FM_STATE_COUNT,
+};
+
+/** What a CO_EV_FM event reports (co_event.fm.what). */
+enum co_mgr_fm_event {
+	/** This node won the negotiation: it is the active master (fm.master_id = own ID). */
+	CO_MGR_FM_EV_ACTIVE,
+	/** Another node is the active master (its 071h: fm.master_id, fm.priority). */
+	CO_MGR_FM_EV_MASTER,
+	/** The active master's heartbeat was lost: 000#8200 sent, take-over started. */
+	CO_MGR_FM_EV_LOST,
+	/** 076h sent to a lower-priority active master (fm.master_id, fm.priority). */
+	CO_MGR_FM_EV_FORCE,
+	/** As active master, 076h received: network reset, negotiation again. */
+	CO_MGR_FM_EV_RESIGN,
+	/** Self-starting device: a master-capable device answered 075h (no start sent). */
+	CO_MGR_FM_EV_CAPABLE,
+	/** Self-starting device: nobody answered 075h, 000#0100 sent (or another's seen). */
+	CO_MGR_FM_EV_SELF_START,
+};
+
+/** Flying-master view of a node (co_mgr_fm_get()). */
+struct co_mgr_fm_info {
+	enum co_mgr_fm_state state;
+	/** Active master's node-ID (own ID when active), 0 if none is known. */
+	uint8_t master_id;
+	/** Active master's priority (1F90h:03 of that node, as its 071h said). */
+	uint8_t master_prio;
+	/** Own priority, 1F90h:03. */
+	uint8_t own_prio;
+	/** Times this node became the active master since init. */
+	uint16_t wins;
+	/** When the last master change was seen [µs, node time]. */
+	uint64_t changed_us;
+};
+
+/** @cond INTERNAL_HIDDEN */
+struct co_mgr_fm {
+	struct co_timer timer;       /* the state's wait */
+	struct co_timer cycle;       /* 076h every 1F90h:06 while active */
+	struct co_timer hb_timer;    /* active master's heartbeat */
+	struct co_rx rx;             /* 070h..077h */
+	struct co_rx hb_rx;          /* 700h + active master */
+	struct co_listener listener; /* resets (cold/warm), Operational (self-start) */
+	uint64_t changed_us;
+	uint16_t hb_ms;
+	uint16_t wins;
+	uint8_t state;
+	uint8_t master_id;
+	uint8_t master_prio;
+	uint8_t ev_master; /* the master the last CO_EV_FM named (no repeats after resets) */
+	bool warm;         /* the last reset was a Reset Communication */
+	bool seen_072;     /* a 072h came since this negotiation round began */
+};
+/** @endcond */
+#endif /* CONFIG_CANOPEN_MGR_FLYING */
+
 /** @cond INTERNAL_HIDDEN */
 struct co_mgr;
 
@@ -349,6 +434,9 @@ struct co_mgr {
 	co_mgr_pgm_source_t pgm_source;
 	void *pgm_user_data;
 #endif
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+	struct co_mgr_fm fm; /* flying master, NMT master detection (mgr_fm.c) */
+#endif
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 	struct co_mgr_lss lss; /* node-IDs for missing slaves by LSS (mgr_lss.c) */
 #endif
@@ -407,6 +495,17 @@ void co_mgr_set_ec_ind(struct co_node *node, co_mgr_ec_ind_t cb, void *user_data
 
 /** @brief Set the software version hook (NULL: an update that is needed fails with I). */
 void co_mgr_set_sw_ind(struct co_node *node, co_mgr_sw_ind_t cb, void *user_data);
+
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+/**
+ * @brief The flying-master view of the node: state, active master, priorities.
+ * @retval 0 Filled.
+ */
+int co_mgr_fm_get(struct co_node *node, struct co_mgr_fm_info *info);
+
+/** @brief Name of a flying-master state ("ACTIVE" ...). */
+const char *co_mgr_fm_state_str(enum co_mgr_fm_state state);
+#endif
 
 /** @brief Name of a boot step ("DEVTYPE" ...). */
 const char *co_mgr_step_str(enum co_mgr_step step);

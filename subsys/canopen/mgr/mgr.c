@@ -140,6 +140,11 @@ static int mgr_init(struct co_node *node)
 	if (co_node_listener_add(node, &m->listener) != 0) {
 		return -ENOSPC;
 	}
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+	if (co_mgr_fm_init(m) != 0) {
+		return -ENOSPC;
+	}
+#endif
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 	if (co_mgr_lss_init(m) != 0) {
 		return -ENOSPC;
@@ -235,6 +240,11 @@ int co_mgr_nmt_req(struct co_node *node, uint8_t id, enum co_nmt_cs cs)
 	co_node_lock(node);
 	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
 		err = -EPERM;
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+	} else if ((co_mgr_startup_obj(m) & SU_FLYING) != 0U && !co_mgr_fm_active(m)) {
+		/* A flying-master candidate that is not the active master is a slave. */
+		err = -EPERM;
+#endif
 	} else if (id == node->node_id) {
 		err = co_nmt_req(node, cs);
 	} else {

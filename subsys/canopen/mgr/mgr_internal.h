@@ -13,6 +13,7 @@
  * - mgr_boot.c     "boot NMT slave" (the const step table) and the boot process of one slave
  * - mgr_startup.c  the NMT startup: reset, boot all, 1F89h, halt, start all / individual
  * - mgr_od.c       the hooks on 1F80h-1F83h and the 1F82h read value
+ * - mgr_fm.c       flying master (1F90h) and NMT master detection (1F91h)
  *
  * Every function here runs with the node's mutex held.
  */
@@ -197,6 +198,16 @@ void co_mgr_boot_timer_handler(struct co_timer *timer, uint64_t now_us);
 /* Keep the 1F82h read value (the master's view of the slave's state) up to date. */
 void co_mgr_set_nmt_view(struct co_mgr_slave *s, uint8_t v);
 int co_mgr_od_hooks_register(struct co_mgr *m);
+
+/* --- mgr_fm.c: flying master, NMT master detection ----------------------------------------- */
+
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+int co_mgr_fm_init(struct co_mgr *m);
+/* The NMT startup began (after our boot-up): a candidate negotiates, a self-starter asks. */
+void co_mgr_fm_begin(struct co_mgr *m);
+/* Whether this node won the negotiation (the manager's functions run). */
+bool co_mgr_fm_active(struct co_mgr *m);
+#endif
 
 /* --- mgr_lss.c: node-IDs for missing slaves by LSS -------------------------------------------- */
 

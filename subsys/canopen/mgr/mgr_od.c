@@ -188,9 +188,13 @@ static uint32_t req_guard_validate(struct co_od *od, struct co_od_req *req, void
 static uint32_t startup_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	uint32_t v = (uint32_t)co_od_req_uint(req);
+	uint32_t ok =
+		SU_MASTER | SU_START_ALL | SU_NO_SELF_OP | SU_NO_START | SU_RESET_ALL | SU_STOP_ALL;
 
-	if ((v & ~(uint32_t)(SU_MASTER | SU_START_ALL | SU_NO_SELF_OP | SU_NO_START | SU_RESET_ALL |
-			     SU_STOP_ALL)) != 0U) {
+	if (IS_ENABLED(CONFIG_CANOPEN_MGR_FLYING)) {
+		ok |= SU_FLYING;
+	}
+	if ((v & ~ok) != 0U) {
 		return CO_SDO_AB_INVALID_VALUE;
 	}
 	return 0U;

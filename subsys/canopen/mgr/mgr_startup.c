@@ -187,12 +187,22 @@ static void startup_begin(struct co_mgr *m)
 		if (su == SU_SELF_START) {
 			(void)co_nmt_req(m->node, CO_NMT_CS_START);
 		}
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+		if ((su & ~(uint32_t)SU_FLYING) == SU_START_ALL) {
+			/* 02h: start the network only if no master-capable device answers. */
+			co_mgr_fm_begin(m);
+		}
+#endif
 		return;
 	}
-	if ((su & SU_FLYING) != 0U) {
-		LOG_WRN("%s: flying master not supported; acting as the only master",
-			m->node->name);
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+	if ((su & SU_FLYING) != 0U && !co_mgr_fm_active(m)) {
+		/* A candidate runs the startup once it won the negotiation (mgr_fm.c). */
+		m->phase = PH_NONE;
+		co_mgr_fm_begin(m);
+		return;
 	}
+#endif
 	m->startup = CO_MGR_STARTUP_RUNNING;
 	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
 		struct co_mgr_slave *s = &m->slaves[i];
