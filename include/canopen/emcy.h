@@ -119,6 +119,8 @@ struct co_emcy {
 	uint32_t overflows;
 	struct co_timer inhibit_timer;
 	uint64_t last_tx_us;
+	/* Not before this time: the active line's TX queue was full at the last attempt. */
+	uint64_t retry_us;
 	bool sent_any;
 	uint32_t cob_id;
 	uint16_t inhibit_100us;

@@ -335,6 +335,19 @@ int co_node_set_process_route(struct co_node *node, co_route_t route);
 void co_node_set_tx_excluded(struct co_node *node, co_route_t lines);
 
 /**
+ * @brief Withdraw frames the node queued on the lines of @p route (still waiting for the
+ * driver's back-pressure to clear), e.g. a heartbeat that a newer one replaces.
+ *
+ * @param node The node.
+ * @param route The lines to look at.
+ * @param keep Frames to keep (NULL: none); called with a line's TX lock held, must not block.
+ * @param arg Passed to @p keep.
+ * @return Frames withdrawn (counted in each line's co_line_stats.tx_purged).
+ */
+int co_node_tx_withdraw(struct co_node *node, co_route_t route,
+			bool (*keep)(const struct can_frame *frame, void *arg), void *arg);
+
+/**
  * @brief Free places in the TX queues of a route (the smallest of its lines).
  *
  * @return Frames that can be sent on every line of the route without an overflow; 0 when the

@@ -596,6 +596,20 @@ int co_node_set_process_route(struct co_node *node, co_route_t route)
 	return 0;
 }
 
+int co_node_tx_withdraw(struct co_node *node, co_route_t route,
+			bool (*keep)(const struct can_frame *frame, void *arg), void *arg)
+{
+	int n = 0;
+
+	route = route_resolve(node, route);
+	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
+		if ((route & BIT(i)) != 0U && node->lines[i].line != NULL) {
+			n += co_line_tx_purge(node->lines[i].line, &node->lock, keep, arg);
+		}
+	}
+	return n;
+}
+
 int co_node_tx_space(struct co_node *node, co_route_t route)
 {
 	int space = INT32_MAX;

@@ -83,6 +83,9 @@ static void update_reg(struct co_node *node)
 
 /* --- Frames and the inhibit time ---------------------------------------------------------- */
 
+/* How long an EMCY that found the active line's TX queue full waits before it tries again. */
+#define EMCY_RETRY_US 10000U
+
 static uint64_t inhibit_us(const struct co_emcy *em)
 {
 	return (uint64_t)em->inhibit_100us * 100U;
@@ -108,18 +111,29 @@ static void publish(struct co_node *node, const struct can_frame *f, bool own)
 	(void)co_node_publish(node, &ev, NULL);
 }
 
-static void transmit(struct co_node *node, const uint8_t data[8], uint64_t now_us)
+/*
+ * Send one EMCY frame, or return false when the active line's TX queue is full: the frame
+ * would be dropped there, and an 8110h raised because that queue overflowed would be lost
+ * with the frames it reports. The caller keeps it in the inhibit queue and tries again
+ * EMCY_RETRY_US later.
+ */
+static bool transmit(struct co_node *node, const uint8_t data[8], uint64_t now_us)
 {
 	struct can_frame f = {
 		.id = node->emcy.cob_id & 0x7ffU,
 		.dlc = 8U,
 	};
 
+	if (co_node_tx_space(node, CO_ROUTE_ACTIVE) <= 0) {
+		node->emcy.retry_us = now_us + EMCY_RETRY_US;
+		return false;
+	}
 	memcpy(f.data, data, 8);
 	(void)co_node_send(node, CO_ROUTE_PROCESS, &f);
 	node->emcy.last_tx_us = now_us;
 	node->emcy.sent_any = true;
 	publish(node, &f, true);
+	return true;
 }
 
 static bool producer_on(const struct co_emcy *em)
@@ -132,7 +146,8 @@ static void arm_inhibit(struct co_node *node)
 	struct co_emcy *em = &node->emcy;
 
 	if (em->q_count != 0U) {
-		co_node_timer_start(node, &em->inhibit_timer, em->last_tx_us + inhibit_us(em));
+		co_node_timer_start(node, &em->inhibit_timer,
+				    MAX(em->last_tx_us + inhibit_us(em), em->retry_us));
 	} else {
 		co_timer_stop(&em->inhibit_timer);
 	}
@@ -146,9 +161,10 @@ static void inhibit_expired(struct co_timer *timer, uint64_t now_us)
 	if (em->q_count == 0U || !producer_on(em)) {
 		return;
 	}
-	transmit(node, em->queue[em->q_head], now_us);
-	em->q_head = (uint8_t)((em->q_head + 1U) % CONFIG_CANOPEN_EMCY_QUEUE);
-	em->q_count--;
+	if (transmit(node, em->queue[em->q_head], now_us)) {
+		em->q_head = (uint8_t)((em->q_head + 1U) % CONFIG_CANOPEN_EMCY_QUEUE);
+		em->q_count--;
+	}
 	arm_inhibit(node);
 }
 
@@ -171,9 +187,10 @@ static void emit(struct co_node *node, uint16_t code, uint8_t reg, const uint8_t
 	if (msef != NULL) {
 		memcpy(&data[3], msef, 5);
 	}
-	if (em->q_count == 0U && (!em->sent_any || em->inhibit_100us == 0U ||
-				  co_time_before_eq(em->last_tx_us + inhibit_us(em), now))) {
-		transmit(node, data, now);
+	if (em->q_count == 0U &&
+	    (!em->sent_any || em->inhibit_100us == 0U ||
+	     co_time_before_eq(em->last_tx_us + inhibit_us(em), now)) &&
+	    transmit(node, data, now)) {
 		return;
 	}
 	if (em->q_count == CONFIG_CANOPEN_EMCY_QUEUE) {

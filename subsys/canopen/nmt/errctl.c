@@ -81,6 +81,14 @@ static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
 
 /* --- Heartbeat producer ------------------------------------------------------------------- */
 
+/* Everything but the node's own heartbeats; a boot-up (state 00h) is kept, it tells of a reset. */
+static bool not_a_heartbeat(const struct can_frame *f, void *arg)
+{
+	const struct co_node *node = arg;
+
+	return f->id != CO_NMT_EC_COB_ID + node->node_id || f->data[0] == 0U;
+}
+
 static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
 {
 	struct co_node *node = timer->user_data;
@@ -89,6 +97,11 @@ static void hb_timer_handler(struct co_timer *timer, uint64_t now_us)
 
 	/* Held (redundancy: TPDO supervision) the heartbeat stays silent, its cadence runs on. */
 	if (!node->ec.hb_held) {
+		/*
+		 * A heartbeat still waiting behind back-pressure carries an old state: the new
+		 * one replaces it, so a line that was blocked gets one, not every one it missed.
+		 */
+		(void)co_node_tx_withdraw(node, CO_ROUTE_EC, not_a_heartbeat, node);
 		send_state(node, 0U, CO_ROUTE_EC);
 	}
 	/* Keep the cadence; after a long stall start afresh rather than burst. */
