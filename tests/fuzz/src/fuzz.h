@@ -74,8 +74,8 @@ struct fz_state {
 	bool have_req;
 	/* Test hook (SAFELINE_FUZZ_BREAK=1): Operational counts as an invalid state. */
 	bool break_invariant;
-	/* Set by a harness while it moves the node through a state change itself. */
-	bool in_transition;
+	/* While set, the sink pushes back (-EAGAIN) as a stopped controller would. */
+	bool tx_busy;
 };
 
 extern struct fz_state fz;

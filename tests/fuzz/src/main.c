@@ -10,6 +10,7 @@
  * child processes it starts (crash minimisation) get the same command line back.
  */
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,6 +90,15 @@ static int sink(struct co_line *line, const struct can_frame *f, void *user_data
 {
 	bool ext = (f->flags & CAN_FRAME_IDE) != 0U;
 
+	if (fz.tx_busy) {
+		/* The controller is stopped (LSS bit rate switch): frames wait in the TX queue,
+		 * but an LSS answer must not even be tried, the slave ignores requests then.
+		 */
+		if (f->id == 0x7E4U) {
+			fz_fail("LSS answer %02Xh during the bit timing switch", f->data[0]);
+		}
+		return -EAGAIN;
+	}
 	if (trace) {
 		print_frame("tx", f);
 	}
@@ -96,7 +106,7 @@ static int sink(struct co_line *line, const struct can_frame *f, void *user_data
 	fz.tx_total++;
 	fz.last_req = *f;
 	fz.have_req = true;
-	if (fz.dut != NULL && !ext && !fz.in_transition) {
+	if (fz.dut != NULL && !ext) {
 		if (fz_restricted(f->id) &&
 		    !(fz.h->may_send != NULL ? fz.h->may_send(f) : default_may_send(f))) {
 			fz_fail("frame on restricted identifier %03Xh", f->id);
