@@ -208,6 +208,8 @@ struct co_pdo {
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 	/* RPDO frames dropped as the other line's copy of a frame already taken. */
 	uint32_t rx_duplicates;
+	/* Per line: the supervised nodes whose heartbeat is lost there (CO_EV_REDUNDANCY). */
+	uint32_t hb_lost[2][4];
 #endif
 };
 /** @endcond */

@@ -41,6 +41,7 @@
 #include <canopen/emcy.h>
 #include <canopen/node.h>
 #include <canopen/pdo.h>
+#include <canopen/redundancy.h>
 
 #include "node_internal.h"
 #include "pdo_internal.h"
@@ -272,17 +273,37 @@ static void rpdo_mpdo(struct co_rpdo *r, const struct can_frame *frame)
 }
 
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
+static bool any_lost(const uint32_t lost[4])
+{
+	return (lost[0] | lost[1] | lost[2] | lost[3]) != 0U;
+}
+
+/*
+ * A line on which a supervised node's heartbeat is lost while the other line has them all
+ * is failing: what it still delivers comes late (a cut controller's held frame when it comes
+ * back, frames a flood held up) and the other line has had every value already.
+ */
+static bool line_failing(const struct co_pdo *pdo, uint8_t line)
+{
+	return line < 2U && any_lost(pdo->hb_lost[line]) && !any_lost(pdo->hb_lost[line ^ 1U]);
+}
+
 /*
  * A node on two lines hears a PDO on both. A frame is the copy of one of the last frames taken
  * from the other line when it has the same data within the window; each taken frame has one
  * copy. Keeping several (not just the last) lets a line thread that is late by a few frames
  * catch up without its copies passing as new values. Frames on the same line are never
  * copies (a value may repeat), and after a line is lost the other line's frames are taken as
- * they come.
+ * they come. Nothing is taken from a failing line (line_failing()).
  */
 static bool rpdo_duplicate(struct co_rpdo *r, const struct can_frame *frame, uint64_t now_us)
 {
 	uint8_t line = co_node_rx_line(r->node);
+
+	if (line_failing(&r->node->pdo, line)) {
+		r->node->pdo.rx_duplicates++;
+		return true;
+	}
 
 	for (uint8_t k = 0; k < ARRAY_SIZE(r->taken); k++) {
 		/* Oldest first: equal values pair with their copies in order. */
@@ -761,6 +782,19 @@ static void pdo_sync(struct co_node *node, uint8_t counter, uint64_t now_us, uin
 static int sync_event(struct co_node *node, const struct co_event *ev, void *user_data)
 {
 	ARG_UNUSED(user_data);
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	if (ev->type == CO_EV_REDUNDANCY) {
+		uint8_t id = ev->redundancy.node_id;
+		uint32_t *word = &node->pdo.hb_lost[ev->redundancy.line & 1U][(id / 32U) & 3U];
+
+		if (ev->redundancy.what == CO_RDN_EV_HB_ERROR) {
+			*word |= BIT(id % 32U);
+		} else if (ev->redundancy.what == CO_RDN_EV_HB_OK) {
+			*word &= ~BIT(id % 32U);
+		}
+		return 0;
+	}
+#endif
 	pdo_sync(node, ev->sync.counter, ev->sync.time_us, ev->sync.window_us);
 	return 0;
 }
@@ -1117,8 +1151,12 @@ static int pdo_init(struct co_node *node)
 	}
 #endif
 	if (err == 0) {
-		co_listener_init(&pdo->sync_listener, "pdo", CO_EV_BIT(CO_EV_SYNC), sync_event,
-				 NULL);
+		/* With redundancy also the heartbeats lost per line (rpdo_duplicate()). */
+		co_listener_init(&pdo->sync_listener, "pdo",
+				 CO_EV_BIT(CO_EV_SYNC) | (IS_ENABLED(CONFIG_CANOPEN_REDUNDANCY)
+								  ? CO_EV_BIT(CO_EV_REDUNDANCY)
+								  : 0U),
+				 sync_event, NULL);
 		err = co_node_listener_add(node, &pdo->sync_listener);
 	}
 	return err;
@@ -1148,6 +1186,10 @@ static void pdo_reset_comm(struct co_node *node)
 	struct co_pdo *pdo = &node->pdo;
 
 	pdo->window = false;
+#if defined(CONFIG_CANOPEN_REDUNDANCY)
+	/* The redundancy service supervises afresh from here, without HB_OK events. */
+	memset(pdo->hb_lost, 0, sizeof(pdo->hb_lost));
+#endif
 	for (uint16_t i = 0; i < CO_RPDOS; i++) {
 		struct co_rpdo *r = &pdo->rpdo[i];
 		uint16_t comm = IDX_RPDO_COMM + i;

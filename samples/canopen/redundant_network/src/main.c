@@ -681,8 +681,8 @@ static int summary(void)
 	       co_pdo_rx_duplicates(&MASTER->node));
 	if (dup_total != 0) {
 		printk("redundant_network: KNOWN PROBLEM: %d values reached the application twice: "
-		       "frames a cut controller held went out when its line came back "
-		       "(doc/redundancy.md)\n",
+		       "copies a late line thread delivered after the duplicate window (a loaded "
+		       "host, doc/redundancy.md)\n",
 		       dup_total);
 	}
 	if (early_switches != 0) {

@@ -358,6 +358,49 @@ ZTEST(co_redundancy, test_nmt_from_either_line_and_pdo_copies_delivered_once)
 	zassert_equal(co_pdo_rx_duplicates(&t.node), 1);
 }
 
+static uint8_t rpdo_value(void)
+{
+	uint8_t v = 0;
+
+	co_node_lock(&t.node);
+	zassert_ok(co_od_get_u8(co_node_od(&t.node), 0x6200, 1, &v));
+	co_node_unlock(&t.node);
+	return v;
+}
+
+/* A cut controller's held frame, or frames a flood held up, come late on a failing line. */
+ZTEST(co_redundancy, test_pdo_frames_of_a_line_that_lost_a_heartbeat_are_not_taken)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	uint8_t v;
+
+	rx(D, 0x000, 2, start);
+	heartbeats_until(BIT(D) | BIT(R), BIT(D) | BIT(R), 200 * MS);
+	/* Node 2's heartbeat stops on the default line only: lost there after 100 ms. */
+	heartbeats_until(BIT(R), BIT(D) | BIT(R), 400 * MS);
+	zassert_not_null(last_rdn(CO_RDN_EV_HB_ERROR));
+	v = 0x33;
+	rx(D, 0x182, 1, &v);
+	zassert_not_equal(rpdo_value(), 0x33, "a late frame of the failing line is not taken");
+	v = 0x44;
+	rx(R, 0x182, 1, &v);
+	zassert_equal(rpdo_value(), 0x44, "the other line's frames are");
+	/* Node 2 is back on the default line: its frames are taken again. */
+	heartbeats_until(BIT(D) | BIT(R), BIT(D) | BIT(R), 500 * MS);
+	zassert_not_null(last_rdn(CO_RDN_EV_HB_OK));
+	v = 0x55;
+	rx(D, 0x182, 1, &v);
+	zassert_equal(rpdo_value(), 0x55);
+	/* Heartbeats lost on both lines (node 2 on one, node 3 on the other): both are taken. */
+	heartbeats_until(BIT(R), BIT(D), 800 * MS);
+	v = 0x66;
+	rx(D, 0x182, 1, &v);
+	zassert_equal(rpdo_value(), 0x66, "no line is better than the other");
+	v = 0x77;
+	rx(R, 0x182, 1, &v);
+	zassert_equal(rpdo_value(), 0x77);
+}
+
 ZTEST(co_redundancy, test_sync_counts_from_the_active_line_only)
 {
 	rx(R, 0x080, 0, NULL);

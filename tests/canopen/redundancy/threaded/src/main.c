@@ -22,9 +22,9 @@
  *   slave; a bus-off that recovers at once, error passive, change nothing;
  * - a flood of high-priority frames on the default line acts like a cut.
  *
- * Tests marked KNOWN BUG (ZTEST_EXPECT_FAIL) assert what doc/redundancy.md promises and the
- * service does not do yet; each says why. Remove the mark when the service is fixed (the test
- * then fails as "passed unexpectedly" until the mark goes). Their preconditions are
+ * Tests marked KNOWN BUG (ZTEST_EXPECT_FAIL; none at the moment) assert what doc/redundancy.md
+ * promises and the service does not do yet; each says why. Remove the mark when the service is
+ * fixed (the test then fails as "passed unexpectedly" until the mark goes). Their preconditions are
  * assumptions: one that no longer holds skips the test, which also fails it (a skip is not the
  * failure expected), rather than passing it for the wrong reason.
  */
@@ -443,8 +443,8 @@ static void tally(int slave, struct tally *t)
  * 32 ms a 16-bit receive stamp reaches, after which a frame is stamped when it is handed
  * over) lets copies through: seen with load average 4.5 on two cores, 11 values of node 2
  * again on the redundant line 80-110 ms after the default line's, in the error-passive test.
- * The deterministic cases are strict: test_a_late_line_thread_delivers_no_value_twice (35 ms,
- * passes), test_copies_held_back_on_a_failed_line_are_not_delivered_again (KNOWN BUG).
+ * The deterministic cases are strict: test_a_late_line_thread_delivers_no_value_twice (35 ms)
+ * and test_copies_held_back_on_a_failed_line_are_not_delivered_again.
  */
 #define TOLERATE_CHANCE_DUPLICATES 1
 
@@ -696,14 +696,14 @@ ZTEST(co_redundancy_threaded, test_restore_default_line_switches_back_after_thre
 }
 
 /*
- * KNOWN BUG: a value can reach the application twice after a restore. The process data the
- * node queued on the cut line are withdrawn when its controller goes error passive, but the
- * frame the controller itself holds (handed to the driver before the cut, retransmitted
- * without acknowledgement) goes out when the line comes back, long after its copy on the
- * redundant line: Zephyr's CAN API has no way to abort a frame the driver took. Measured: one
- * value per slave and restore.
+ * No value twice after a restore. The process data the node queued on the cut line are
+ * withdrawn when its controller goes error passive, but the frame the controller itself holds
+ * (handed to the driver before the cut, retransmitted without acknowledgement; Zephyr's CAN
+ * API cannot abort it) goes out when the line comes back, long after its copy on the
+ * redundant line. It comes before any heartbeat there, while the master still has its
+ * supervised heartbeats lost on that line and none on the other: RPDOs of such a line are
+ * not taken (it delivered one value per slave and restore twice before).
  */
-ZTEST_EXPECT_FAIL(co_redundancy_threaded, test_restore_default_line_delivers_no_value_twice);
 ZTEST(co_redundancy_threaded, test_restore_default_line_delivers_no_value_twice)
 {
 	(void)line_cut(D);
@@ -889,19 +889,16 @@ ZTEST(co_redundancy_threaded, test_error_passive_changes_nothing)
 /* --- Copies held back on a line that failed ------------------------------------------------ */
 
 /*
- * KNOWN BUG: a copy that a failed line delivers later than CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US
- * reaches the application a second time. Here, as in a flood that lets a frame through now and
- * then (test_flood_on_the_default_line_acts_like_a_cut, seen 75-270 ms late), the default line
- * carries no heartbeat (every node switches away from it) and its TPDOs arrive 150 ms late. The
- * filter matches a copy only within the window after the frame it took, and RPDOs are taken
- * from a line whose heartbeats are lost and that is no longer active as from a working one.
- * Dropping RPDOs from a line while the node has lost its supervised heartbeats there (or
- * while it is not the active line after a switch away from it) would close this.
+ * A copy that a failed line delivers later than CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US is not
+ * taken again. Here, as in a flood that lets a frame through now and then
+ * (test_flood_on_the_default_line_acts_like_a_cut, seen 75-270 ms late), the default line
+ * carries no heartbeat (every node switches away from it) and its TPDOs arrive 150 ms late.
+ * The filter matches a copy only within the window after the frame it took; what closes it
+ * is that RPDOs are not taken from a line on which a supervised heartbeat is lost while the
+ * other line has them all (40 values per slave were delivered twice before).
  */
 #define HELD_BACK_MS 150U
 
-ZTEST_EXPECT_FAIL(co_redundancy_threaded,
-		  test_copies_held_back_on_a_failed_line_are_not_delivered_again);
 ZTEST(co_redundancy_threaded, test_copies_held_back_on_a_failed_line_are_not_delivered_again)
 {
 	const struct can_filter heartbeats = {.id = 0x700, .mask = 0x780};
@@ -954,9 +951,10 @@ ZTEST(co_redundancy_threaded, test_flood_on_the_default_line_acts_like_a_cut)
 		 ms_of(now_us() - at), through);
 	/*
 	 * Frames queued behind the flood slip through whenever the flooder's thread is late to
-	 * refill its controller, tens to hundreds of ms late: copies older than the window, taken
-	 * again (KNOWN BUG, test_copies_held_back_on_a_failed_line_are_not_delivered_again). How
-	 * many depends on the host's load, so they are printed here, not judged.
+	 * refill its controller, tens to hundreds of ms late: copies older than the window. Once
+	 * the heartbeats there are lost they are not taken
+	 * (test_copies_held_back_on_a_failed_line_are_not_delivered_again); before that they
+	 * may be, depending on the host's load, so they are printed here, not judged.
 	 */
 	assert_values(true, false);
 	flood_stop();
