@@ -188,7 +188,10 @@ static void startup_begin(struct co_mgr *m)
 			(void)co_nmt_req(m->node, CO_NMT_CS_START);
 		}
 #if defined(CONFIG_CANOPEN_MGR_FLYING)
-		if ((su & ~(uint32_t)SU_FLYING) == SU_START_ALL) {
+		if (su == (SU_SELF_START | SU_FLYING)) {
+			/* 28h (CiA 302 only): a self-starting slave as 08h. */
+			(void)co_nmt_req(m->node, CO_NMT_CS_START);
+		} else if ((su & ~(uint32_t)SU_FLYING) == SU_START_ALL) {
 			/* 02h: start the network only if no master-capable device answers. */
 			co_mgr_fm_begin(m);
 		}

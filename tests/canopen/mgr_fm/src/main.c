@@ -678,6 +678,26 @@ ZTEST(co_mgr_fm, test_s9_61_self_starting_slave_sends_nothing)
 	zassert_equal(count(0x000, 0, 0) + count(0x075, 0, 0), 0);
 }
 
+ZTEST(co_mgr_fm, test_s9_61_self_starting_28h_as_08h)
+{
+	node_add(0, 7, true);
+	cfg(0, 0x1F80, 0, 0x28, 4);
+	start_all();
+	run_ms(2000);
+	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_OPERATIONAL);
+	zassert_equal(count(0x000, 0, 0) + count(0x075, 0, 0) + count(0x073, 0, 0), 0);
+}
+
+ZTEST(co_mgr_fm, test_s9_59_self_starter_22h_as_02h)
+{
+	node_add(0, 7, true);
+	cfg(0, 0x1F80, 0, 0x22, 4);
+	start_all();
+	run_ms(1000);
+	zassert_equal(at_ms(find(0x075, 0, 0)), 500);
+	zassert_equal(at_ms(find_nmt(0x01, 0x00, 0, 0)), 500 + 100 + 105);
+}
+
 ZTEST(co_mgr_fm, test_wrong_dlc_ignored)
 {
 	uint64_t since;
