@@ -63,6 +63,12 @@ static void put_hex(struct eds_out *o, const uint8_t *p, size_t n)
 	}
 }
 
+/* One byte of a UTF-8 sequence; v is masked to its 8 bits by the caller's lead or 0x3F. */
+static char utf8_byte(uint32_t v)
+{
+	return (char)(uint8_t)v;
+}
+
 /* UTF-16 units to UTF-8, stopping at the first NUL unit. */
 static void put_utf16(struct eds_out *o, const uint8_t *mem, size_t units)
 {
@@ -90,19 +96,19 @@ static void put_utf16(struct eds_out *o, const uint8_t *mem, size_t units)
 			b[0] = (char)cp;
 			n = 1;
 		} else if (cp < 0x800U) {
-			b[0] = (char)(0xC0U | (cp >> 6));
-			b[1] = (char)(0x80U | (cp & 0x3FU));
+			b[0] = utf8_byte(0xC0U | (cp >> 6));
+			b[1] = utf8_byte(0x80U | (cp & 0x3FU));
 			n = 2;
 		} else if (cp < 0x10000U) {
-			b[0] = (char)(0xE0U | (cp >> 12));
-			b[1] = (char)(0x80U | ((cp >> 6) & 0x3FU));
-			b[2] = (char)(0x80U | (cp & 0x3FU));
+			b[0] = utf8_byte(0xE0U | (cp >> 12));
+			b[1] = utf8_byte(0x80U | ((cp >> 6) & 0x3FU));
+			b[2] = utf8_byte(0x80U | (cp & 0x3FU));
 			n = 3;
 		} else {
-			b[0] = (char)(0xF0U | (cp >> 18));
-			b[1] = (char)(0x80U | ((cp >> 12) & 0x3FU));
-			b[2] = (char)(0x80U | ((cp >> 6) & 0x3FU));
-			b[3] = (char)(0x80U | (cp & 0x3FU));
+			b[0] = utf8_byte(0xF0U | (cp >> 18));
+			b[1] = utf8_byte(0x80U | ((cp >> 12) & 0x3FU));
+			b[2] = utf8_byte(0x80U | ((cp >> 6) & 0x3FU));
+			b[3] = utf8_byte(0x80U | (cp & 0x3FU));
 			n = 4;
 		}
 		put(o, b, n);
@@ -215,6 +221,8 @@ static void put_sub(struct eds_out *o, const struct co_od_def *def, const struct
 			put_rel(o, d->dtype, n->base);
 		} else if (storage) {
 			put_value(o, d, mem);
+		} else {
+			/* A DOMAIN without storage has no default: the key stays empty. */
 		}
 		puts_(o, "\n");
 	}

@@ -107,6 +107,8 @@ static int find_current(struct co_storage *st)
 		st->active = (int32_t)(seq[1] - seq[0]) > 0 ? 1 : 0;
 	} else if (ok[0] || ok[1]) {
 		st->active = ok[0] ? 0 : 1;
+	} else {
+		/* No valid image: active stays -1. */
 	}
 	st->seq = st->active >= 0 ? seq[st->active] : 0U;
 	return 0;
@@ -236,6 +238,8 @@ static int write_image(struct co_storage *st, uint32_t save_mask, uint32_t drop_
 			if (keep[g] >= 0) {
 				total += BLOCK_HDR + size[g];
 			}
+		} else {
+			/* Dropped: keep[g] = -1 leaves the group out of the new image. */
 		}
 	}
 	if (total > st->slot_size - SLOT_HDR) {
