@@ -119,8 +119,13 @@ struct co_pdo_map_ent {
 	/* The object; info.index 0001h-0007h with no desc/prov marks a dummy entry. */
 	struct co_od_info info;
 	struct co_od_cover cover; /* hooks covering the object, refreshed by the accessors */
-	uint8_t bits;             /* mapped length */
-	bool whole;               /* the whole object, whole bytes: moved without masking */
+#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
+	uint8_t bits; /* mapped length */
+	bool whole;   /* the whole object, whole bytes: moved without masking */
+#endif
+	/* Without bit-wise mapping an entry is always its whole object: the length is
+	 * info.size (co_pdo_ent_bits()), 4 bytes less per entry on a 32-bit target.
+	 */
 };
 
 /* A compiled mapping: entries in frame order, bit offsets implied by their lengths. */

@@ -189,11 +189,11 @@ static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n
 		if (ab != 0U) {
 			return ab;
 		}
-		total += ent.bits;
+		total += co_pdo_ent_bits(&ent);
 		if (total > CO_PDO_MAX_BITS) {
 			return CO_SDO_AB_MAP_LEN;
 		}
-		if (ent.bits % 8U != 0U) {
+		if (co_pdo_ent_bits(&ent) % 8U != 0U) {
 			bytewise = false;
 		}
 		/* Consecutive sub-indexes of one object share a change-of-state hook. */

@@ -51,6 +51,30 @@ static inline bool co_pdo_ent_is_dummy(const struct co_pdo_map_ent *ent)
 }
 
 /*
+ * Mapped length of an entry in bits. Without bit-wise mapping co_pdo_map_check() lets only
+ * whole objects in whole bytes through, and gives a dummy the size of its type, so the
+ * length is the object's size and the entry does not store it.
+ */
+static inline unsigned int co_pdo_ent_bits(const struct co_pdo_map_ent *ent)
+{
+#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
+	return ent->bits;
+#else
+	return ent->info.size * 8U;
+#endif
+}
+
+/* Whether an entry is its whole object in whole bytes (moved without masking). */
+static inline bool co_pdo_ent_whole(const struct co_pdo_map_ent *ent)
+{
+#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
+	return ent->whole;
+#else
+	return !co_pdo_ent_is_dummy(ent);
+#endif
+}
+
+/*
  * The entry functions below keep ent->cover (which OD hooks cover the object) up to date,
  * hence the non-const entries.
  *
@@ -95,7 +119,7 @@ static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_p
 		unsigned int off = 0;
 
 		for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
-			unsigned int bytes = ent->bits / 8U;
+			unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
 
 			(void)co_od_copy_word(&frame[off], od->ram + ent->info.desc->offset, bytes);
 			off += bytes;
@@ -120,7 +144,7 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 
 		for (uint8_t i = 0; i < map->n; i++) {
 			struct co_pdo_map_ent *ent = &map->ent[i];
-			unsigned int bytes = ent->bits / 8U;
+			unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
 
 			(void)co_od_copy_word(od->ram + ent->info.desc->offset, &data[off], bytes);
 			co_od_cover_notify(od, &ent->info, &ent->cover, &data[off], bytes,

@@ -50,7 +50,9 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 	bool bitwise = IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING);
 
 	memset(ent, 0, sizeof(*ent));
+#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	ent->bits = bits;
+#endif
 	if (index >= 1U && index <= 7U) {
 		/* Dummy entries only skip bits of received frames. */
 		if (!rx || sub != 0U || bits != dummy_bits[index] ||
@@ -59,6 +61,8 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 		}
 		ent->info.index = index;
 		ent->info.dtype = (uint8_t)index;
+		/* Its whole bytes: the length co_pdo_ent_bits() gives without bit-wise mapping. */
+		ent->info.size = (uint32_t)bits / 8U;
 		return 0U;
 	}
 	uint32_t ab = co_od_find(od, index, sub, &ent->info);
@@ -81,7 +85,9 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 	if (bits < size_bits && (!bitwise || co_dtype_size(ent->info.dtype) == 0U)) {
 		return CO_SDO_AB_NO_MAP;
 	}
+#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	ent->whole = bits == size_bits;
+#endif
 	return 0U;
 }
 
@@ -118,7 +124,7 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 {
 	size_t len = 0;
 	size_t cap = ent->info.size < 8U ? ent->info.size : 8U;
-	unsigned int whole = ent->bits / 8U;
+	unsigned int whole = co_pdo_ent_bits(ent) / 8U;
 	uint32_t ab;
 
 	memset(out, 0, 8);
@@ -128,8 +134,8 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 		return ab;
 	}
 	/* Keep only the mapped bits (bit-wise mapping of part of a number). */
-	if (ent->bits % 8U != 0U) {
-		out[whole] &= (uint8_t)((1U << (ent->bits % 8U)) - 1U);
+	if (co_pdo_ent_bits(ent) % 8U != 0U) {
+		out[whole] &= (uint8_t)((1U << (co_pdo_ent_bits(ent) % 8U)) - 1U);
 		whole++;
 	}
 	if (whole < 8U) {
@@ -146,9 +152,10 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 
 	memcpy(buf, val, sizeof(buf));
 	/* A signed number mapped in part keeps its sign. */
-	if (ent->bits < size * 8U && co_dtype_class(ent->info.dtype) == CO_DTYPE_CLASS_INT &&
-	    ((buf[(ent->bits - 1U) / 8U] >> ((ent->bits - 1U) % 8U)) & 1U)) {
-		for (unsigned int b = ent->bits; b < size * 8U; b++) {
+	if (co_pdo_ent_bits(ent) < size * 8U &&
+	    co_dtype_class(ent->info.dtype) == CO_DTYPE_CLASS_INT &&
+	    ((buf[(co_pdo_ent_bits(ent) - 1U) / 8U] >> ((co_pdo_ent_bits(ent) - 1U) % 8U)) & 1U)) {
+		for (unsigned int b = co_pdo_ent_bits(ent); b < size * 8U; b++) {
 			buf[b / 8U] |= (uint8_t)(1U << (b % 8U));
 		}
 	}
@@ -163,9 +170,9 @@ static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool
 	}
 	for (uint8_t i = 0; i < map->n; i++) {
 		const struct co_pdo_map_ent *ent = &map->ent[i];
-		unsigned int bytes = ent->bits / 8U;
+		unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
 
-		if (!ent->whole || co_pdo_ent_is_dummy(ent) || ent->info.desc == NULL ||
+		if (!co_pdo_ent_whole(ent) || co_pdo_ent_is_dummy(ent) || ent->info.desc == NULL ||
 		    (bytes != 1U && bytes != 2U && bytes != 4U && bytes != 8U) ||
 		    !(rx ? co_od_cover_plain_write(od, &ent->cover)
 			 : co_od_cover_plain_read(od, &ent->cover))) {
@@ -192,21 +199,22 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 		struct co_pdo_map_ent *ent = &map->ent[i];
 		size_t len;
 
-		if (!BITWISE || (map->bytewise && ent->whole)) {
+		if (!BITWISE || (map->bytewise && co_pdo_ent_whole(ent))) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
 			if (co_od_read_cached(od, &ent->info, &ent->cover, &data[off / 8U],
-					      ent->bits / 8U, &len, CO_OD_WRITER_PDO) != 0U) {
-				memset(&data[off / 8U], 0, ent->bits / 8U);
+					      co_pdo_ent_bits(ent) / 8U, &len,
+					      CO_OD_WRITER_PDO) != 0U) {
+				memset(&data[off / 8U], 0, co_pdo_ent_bits(ent) / 8U);
 			}
 		} else {
 			(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
 			if (map->bytewise) {
-				memcpy(&data[off / 8U], val, ent->bits / 8U);
+				memcpy(&data[off / 8U], val, co_pdo_ent_bits(ent) / 8U);
 			} else {
-				co_pdo_bits_put(data, off, ent->bits, val);
+				co_pdo_bits_put(data, off, co_pdo_ent_bits(ent), val);
 			}
 		}
-		off += ent->bits;
+		off += co_pdo_ent_bits(ent);
 	}
 	map->fast_gen = map_plain(od, map, false) ? od->hook_gen : 0U;
 	return (uint8_t)((map->bits + 7U) / 8U);
@@ -222,20 +230,21 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 	for (uint8_t i = from; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
 
-		if (BITWISE ? map->bytewise && ent->whole : !co_pdo_ent_is_dummy(ent)) {
+		if (BITWISE ? map->bytewise && co_pdo_ent_whole(ent) : !co_pdo_ent_is_dummy(ent)) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
 			refused += co_od_write_cached(od, &ent->info, &ent->cover, &data[off],
-						      ent->bits / 8U, CO_OD_WRITER_PDO) != 0U;
+						      co_pdo_ent_bits(ent) / 8U,
+						      CO_OD_WRITER_PDO) != 0U;
 		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));
 			if (map->bytewise) {
-				memcpy(val, &data[off], ent->bits / 8U);
+				memcpy(val, &data[off], co_pdo_ent_bits(ent) / 8U);
 			} else {
-				co_pdo_bits_get(data, off, ent->bits, val);
+				co_pdo_bits_get(data, off, co_pdo_ent_bits(ent), val);
 			}
 			refused += co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO) != 0U;
 		}
-		off += map->bytewise ? ent->bits / 8U : ent->bits;
+		off += map->bytewise ? co_pdo_ent_bits(ent) / 8U : co_pdo_ent_bits(ent);
 	}
 	map->fast_gen = map_plain(od, map, true) ? od->hook_gen : 0U;
 	return refused;
