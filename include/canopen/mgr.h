@@ -325,6 +325,7 @@ struct co_mgr_fm {
 	uint8_t ev_master; /* the master the last CO_EV_FM named (no repeats after resets) */
 	bool warm;         /* the last reset was a Reset Communication */
 	bool seen_072;     /* a 072h came since this negotiation round began */
+	bool bus_off;      /* our controller is (was) bus-off: restart the round on recovery */
 };
 /** @endcond */
 #endif /* CONFIG_CANOPEN_MGR_FLYING */

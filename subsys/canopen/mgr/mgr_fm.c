@@ -20,6 +20,7 @@
 #include <errno.h>
 #include <string.h>
 
+#include <zephyr/drivers/can.h>
 #include <zephyr/kernel.h>
 #include <zephyr/logging/log.h>
 
@@ -60,8 +61,9 @@ enum fm_ev {
 	E_073,
 	E_074,
 	E_076,
-	E_HB_LOST, /* the active master's heartbeat was lost */
-	E_OPER,    /* we entered Operational (a self-starter's start came from elsewhere) */
+	E_HB_LOST,   /* the active master's heartbeat was lost */
+	E_OPER,      /* we entered Operational (a self-starter's start came from elsewhere) */
+	E_RECOVERED, /* our controller came back from bus-off */
 	E_COUNT,
 };
 
@@ -329,6 +331,20 @@ static uint8_t a_lost(struct co_mgr *m, const struct fm_ev_data *ev)
 	return KEEP;
 }
 
+/*
+ * Back from bus-off while detecting or negotiating: frames of this round were missed and the
+ * error frames shifted the time slots (302 §5.5.4), so the round starts again from F1.
+ */
+static uint8_t a_restart(struct co_mgr *m, const struct fm_ev_data *ev)
+{
+	ARG_UNUSED(ev);
+	LOG_WRN("%s: bus-off during the negotiation: detecting again", m->node->name);
+	m->fm.seen_072 = false;
+	m->fm.warm = true;
+	arm(m, fm_obj(m, FT_DELAY));
+	return CO_MGR_FM_DELAY;
+}
+
 /* Self-starting device: is a master-capable device there? */
 static uint8_t a_ss_ask(struct co_mgr *m, const struct fm_ev_data *ev)
 {
@@ -398,17 +414,21 @@ static const struct fm_tr {
 	{CO_MGR_FM_DELAY, E_TIMER, a_ask, CO_MGR_FM_DETECT},
 	{CO_MGR_FM_DELAY, E_071, a_071, KEEP},
 	{CO_MGR_FM_DELAY, E_072, a_072, KEEP},
+	{CO_MGR_FM_DELAY, E_RECOVERED, a_restart, KEEP},
 	/* F2: nobody answered within 1F90h:01 (cold: reset all; warm: negotiate). */
 	{CO_MGR_FM_DETECT, E_TIMER, a_no_master, KEEP},
 	{CO_MGR_FM_DETECT, E_071, a_071, KEEP},
 	{CO_MGR_FM_DETECT, E_072, a_072, KEEP},
+	{CO_MGR_FM_DETECT, E_RECOVERED, a_restart, KEEP},
 	/* Forced a lower-priority master; no reset came: ask again. */
 	{CO_MGR_FM_FORCED, E_TIMER, a_ask, CO_MGR_FM_DETECT},
 	{CO_MGR_FM_FORCED, E_072, a_072, KEEP},
+	{CO_MGR_FM_FORCED, E_RECOVERED, a_restart, KEEP},
 	/* F3: our slot came first, or someone else's 071h did. */
 	{CO_MGR_FM_NEGOTIATE, E_TIMER, a_win, KEEP},
 	{CO_MGR_FM_NEGOTIATE, E_071, a_071, KEEP},
 	{CO_MGR_FM_NEGOTIATE, E_072, a_072, KEEP},
+	{CO_MGR_FM_NEGOTIATE, E_RECOVERED, a_restart, KEEP},
 	/* F4: the active master. */
 	{CO_MGR_FM_ACTIVE, E_073, a_identify, KEEP},
 	{CO_MGR_FM_ACTIVE, E_072, a_identify, KEEP},
@@ -573,6 +593,16 @@ static int fm_event(struct co_node *node, const struct co_event *ev, void *user_
 		m->fm.state = CO_MGR_FM_OFF;
 	} else if (ev->type == CO_EV_NMT_STATE && ev->nmt.to == CO_NMT_OPERATIONAL) {
 		fm_post(m, E_OPER, 0U, 0U);
+	} else if (ev->type == CO_EV_LINE && ev->line.idx == (uint8_t)CO_LINE_DEFAULT &&
+		   ev->line.event == CO_LINE_EV_CAN_STATE) {
+		if (ev->line.arg == (int)CAN_STATE_BUS_OFF) {
+			m->fm.bus_off = true;
+		} else if (ev->line.arg == (int)CAN_STATE_ERROR_ACTIVE && m->fm.bus_off) {
+			m->fm.bus_off = false;
+			fm_post(m, E_RECOVERED, 0U, 0U);
+		} else {
+			/* Warning or passive: still on the bus. */
+		}
 	}
 	return 0;
 }
@@ -643,7 +673,9 @@ int co_mgr_fm_init(struct co_mgr *m)
 	}
 	co_rx_init(&m->fm.hb_rx, 0x700U, fm_hb_rx, &node->lock, m);
 	co_listener_init(&m->fm.listener, "mgr_fm",
-			 CO_EV_BIT(CO_EV_NMT_RESET) | CO_EV_BIT(CO_EV_NMT_STATE), fm_event, m);
+			 CO_EV_BIT(CO_EV_NMT_RESET) | CO_EV_BIT(CO_EV_NMT_STATE) |
+				 CO_EV_BIT(CO_EV_LINE),
+			 fm_event, m);
 	if (co_node_listener_add(node, &m->fm.listener) != 0) {
 		return -ENOSPC;
 	}

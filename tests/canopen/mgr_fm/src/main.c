@@ -24,6 +24,8 @@
 #include <canopen/node.h>
 #include <canopen/sdo_abort.h>
 
+#include "line_internal.h"
+
 #include "fm_master_od.h"
 #include "fm_slave_od.h"
 
@@ -731,6 +733,34 @@ ZTEST(co_mgr_fm, test_wrong_dlc_071_does_not_stop_negotiation)
 	zassert_equal(fm(0).state, CO_MGR_FM_DETECT);
 	run_ms(100);
 	zassert_equal(count(0x000, 0, 0), 1, "cold boot, nobody answered: 000#8200");
+}
+
+ZTEST(co_mgr_fm, test_bus_off_during_negotiation_restarts_it)
+{
+	candidate(0, 5, 1);
+	start_all();
+	/* Negotiating from 1200 ms (072h), own slot at 2750 ms. */
+	run_ms(1300);
+	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+	run_ms(100);
+	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
+	settle();
+	zassert_equal(fm(0).state, CO_MGR_FM_DELAY);
+	run_ms(3000);
+	/* Again from F1: 073h +500, (warm) 072h +100, 071h +1550. */
+	zassert_equal(at_ms(find(0x073, 0, 1401 * MS)), 1900);
+	zassert_equal(at_ms(find(0x072, 0, 1401 * MS)), 2000);
+	zassert_equal(count(0x071, 0, 0), 1);
+	zassert_equal(at_ms(find(0x071, 0, 0)), 3550);
+}
+
+ZTEST(co_mgr_fm, test_bus_off_of_the_active_master_keeps_it)
+{
+	lone_active(10, 0);
+	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
+	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
+	settle();
+	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE, "its 076h cycle finds a second master");
 }
 
 ZTEST(co_mgr_fm, test_1f90_timing_rule_checked_on_write)
