@@ -282,6 +282,14 @@ static void nmt_reset(struct co_node *node, enum co_nmt_cs cs)
 	if (node->nmt.state != CO_NMT_INITIALISING) {
 		nmt_enter(node, CO_NMT_INITIALISING);
 	}
+	/* What the node queued before (held by back-pressure or a stopped controller) belongs
+	 * to the communication being reset, maybe to its old node-ID: it stays unsent.
+	 */
+	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
+		if (node->lines[i].line != NULL) {
+			(void)co_line_tx_purge(node->lines[i].line, &node->lock, NULL, NULL);
+		}
+	}
 	if (cs == CO_NMT_CS_RESET_NODE) {
 		co_od_reset_app(&node->od);
 	}

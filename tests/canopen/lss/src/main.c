@@ -822,6 +822,33 @@ ZTEST(co_lss, test_38_activate_bit_timing_silent_switch_silent_resume)
 	zassert_equal(co_lss_get_state(&t.node), CO_LSS_STATE_CONFIGURATION);
 }
 
+/*
+ * Found by the lss fuzzing harness: a Reset Communication during the switch gives the node
+ * its new node-ID, yet the heartbeats held for the old one used to go out at the resume, as
+ * if node 05h were still there. The reset withdraws what the node had queued.
+ */
+ZTEST(co_lss, test_38_reset_during_the_switch_drops_the_frames_held_for_the_old_node_id)
+{
+	uint64_t t0;
+
+	to_configuration();
+	ask(0x11, 0x0A, 0x00, CO_LSS_ERR_OK); /* node-ID 0Ah, pending */
+	ask(0x13, 0x00, 0x03, CO_LSS_ERR_OK);
+	co_sim_run_until(1000 * MS);
+	t0 = sim.now;
+	sim.n_sent = 0;
+	req(0x15, 0x64, 0x00, 0, 0, 0, 0, 0); /* 100 ms each delay */
+	co_sim_run_until(t0 + 120 * MS);      /* heartbeats of 05h held */
+	zassert_equal(sim.n_sent, 0);
+	co_sim_nmt(CO_NMT_CS_RESET_COMMUNICATION, NODE_ID);
+	zassert_equal(co_node_id(&t.node), 0x0A);
+	co_sim_run_until(t0 + 200 * MS);
+	zassert_true(sim.n_sent > 0, "the node speaks again after the switch");
+	zassert_equal(count_id(0x700 + NODE_ID), 0, "nothing of the old node-ID");
+	zassert_equal(sim.sent[0].id, 0x70A, "the boot-up of 0Ah comes first");
+	zassert_equal(sim.sent[0].data[0], 0x00);
+}
+
 ZTEST(co_lss, test_38_requests_during_the_switch_are_ignored)
 {
 	to_configuration();
