@@ -36,6 +36,7 @@
 #include <canopen/event.h>
 #include <canopen/line.h>
 #include <canopen/nmt.h>
+#include <canopen/sdo_cli.h>
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 #include <canopen/mgr_lss.h>
 #endif
@@ -326,6 +327,7 @@ struct co_mgr_fm {
 	bool warm;         /* the last reset was a Reset Communication */
 	bool seen_072;     /* a 072h came since this negotiation round began */
 	bool bus_off;      /* our controller is (was) bus-off: restart the round on recovery */
+	uint8_t req_val;   /* value of the running request NMT/guarding (co_mgr_request_*()) */
 };
 /** @endcond */
 #endif /* CONFIG_CANOPEN_MGR_FLYING */
@@ -506,6 +508,33 @@ int co_mgr_fm_get(struct co_node *node, struct co_mgr_fm_info *info);
 
 /** @brief Name of a flying-master state ("ACTIVE" ...). */
 const char *co_mgr_fm_state_str(enum co_mgr_fm_state state);
+
+/**
+ * @brief Request NMT from a device that is not the active master (CiA 302 §5.4, 302-2 §6.4).
+ *
+ * Other devices must not send NMT frames themselves; they write 1F82h:@p id of the active
+ * master, which sends the command. This writes @p value to 1F82h:@p id of the active master
+ * this node knows (co_mgr_fm_get(): a candidate that is a slave), over SDO client
+ * @p cli_num, asynchronously; @p con gets the master's answer (0, or an abort code such as
+ * 06090030h for a value it refuses, 08000022h if it is not the master any more).
+ *
+ * @param value 04h stop, 05h start, 06h reset node, 07h reset communication, 7Fh
+ *        pre-operational (@p id 80h: all nodes).
+ * @retval 0 Sent; @p con follows.
+ * @retval -EINVAL @p id outside 1..80h, another @p value, or no client @p cli_num.
+ * @retval -ENOENT No active master known.
+ * @retval -EPERM This node is the active master (write its own 1F82h).
+ * @retval other As co_sdo_cli_set_server() / co_sdo_cli_download_req() (-EBUSY ...).
+ */
+int co_mgr_request_nmt(struct co_node *node, uint8_t cli_num, uint8_t id, uint8_t value,
+		       co_sdo_cli_con_t con, void *user_data);
+
+/**
+ * @brief Request node guarding from the active master: 1F83h:@p id = @p on (1 start, 0 stop).
+ * @return As co_mgr_request_nmt().
+ */
+int co_mgr_request_guarding(struct co_node *node, uint8_t cli_num, uint8_t id, bool on,
+			    co_sdo_cli_con_t con, void *user_data);
 #endif
 
 /** @brief Name of a boot step ("DEVTYPE" ...). */

@@ -698,3 +698,48 @@ int co_mgr_fm_get(struct co_node *node, struct co_mgr_fm_info *info)
 	co_node_unlock(node);
 	return 0;
 }
+
+/* A write to the active master's request object (1F82h/1F83h) over our SDO client. */
+static int request(struct co_node *node, uint8_t cli_num, uint16_t index, uint8_t id, uint8_t value,
+		   co_sdo_cli_con_t con, void *user_data)
+{
+	struct co_mgr *m = &node->mgr;
+	struct co_sdo_cli *cli = co_sdo_cli_get(node, cli_num);
+	int err;
+
+	if (cli == NULL || con == NULL || id == 0U || id > ALL_NODES) {
+		return -EINVAL;
+	}
+	co_node_lock(node);
+	if (m->fm.state == CO_MGR_FM_ACTIVE) {
+		err = -EPERM;
+	} else if (m->fm.state != CO_MGR_FM_SLAVE || m->fm.master_id == 0U) {
+		err = -ENOENT;
+	} else {
+		err = co_sdo_cli_set_server(cli, m->fm.master_id);
+		if (err == 0) {
+			/* Kept here: the client reads the data while it sends. */
+			m->fm.req_val = value;
+			err = co_sdo_cli_download_req(cli, index, id, &m->fm.req_val, 1U,
+						      CO_SDO_CLI_AUTO, 0U, con, user_data);
+		}
+	}
+	co_node_unlock(node);
+	return err;
+}
+
+int co_mgr_request_nmt(struct co_node *node, uint8_t cli_num, uint8_t id, uint8_t value,
+		       co_sdo_cli_con_t con, void *user_data)
+{
+	if (value != 0x04U && value != 0x05U && value != 0x06U && value != 0x07U &&
+	    value != 0x7fU) {
+		return -EINVAL;
+	}
+	return request(node, cli_num, IDX_REQ_NMT, id, value, con, user_data);
+}
+
+int co_mgr_request_guarding(struct co_node *node, uint8_t cli_num, uint8_t id, bool on,
+			    co_sdo_cli_con_t con, void *user_data)
+{
+	return request(node, cli_num, IDX_REQ_GUARD, id, on ? 1U : 0U, con, user_data);
+}

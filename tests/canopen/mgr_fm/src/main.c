@@ -909,6 +909,63 @@ ZTEST(co_mgr_fm, test_force_negotiation_by_higher_priority)
 	check_stable(1, 0);
 }
 
+static int n_con;
+static uint32_t con_abort;
+
+static void req_con(struct co_sdo_cli *cli, uint32_t abort_code, size_t size, void *user_data)
+{
+	ARG_UNUSED(cli);
+	ARG_UNUSED(size);
+	ARG_UNUSED(user_data);
+	n_con++;
+	con_abort = abort_code;
+}
+
+ZTEST(co_mgr_fm, test_request_nmt_through_the_active_master)
+{
+	uint64_t since;
+
+	n_con = 0;
+	network(3, 0, 2, 1);
+	start_all();
+	run_ms(6000);
+	check_stable(0, 1);
+	/* Node 2 (a slave now) asks the active master to stop node 0Ah: 1F82h:0A = 04h. */
+	since = t.now;
+	zassert_ok(co_mgr_request_nmt(&t.n[1].node, 0, 0x0A, 0x04, req_con, NULL));
+	run_ms(50);
+	zassert_equal(n_con, 1);
+	zassert_equal(con_abort, 0U);
+	zassert_true(find(0x603, 1, since) >= 0, "an SDO request to node 3");
+	zassert_true(find_nmt(0x02, 0x0A, 0, since) >= 0, "node 3 sends the stop");
+	zassert_equal(count(0x000, 1, since), 0, "node 2 sends no NMT frame itself");
+	zassert_equal(co_nmt_get_state(&t.n[2].node), CO_NMT_STOPPED);
+	/* Pre-operational for all nodes (80h): the master applies it to itself too. */
+	zassert_ok(co_mgr_request_nmt(&t.n[1].node, 0, 0x80, 0x7F, req_con, NULL));
+	run_ms(50);
+	zassert_equal(con_abort, 0U);
+	zassert_true(find_nmt(0x80, 0x00, 0, since) >= 0);
+	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_PRE_OPERATIONAL);
+	/* Guarding of 0Ah needs a guard time in the master's 1F81h: the master refuses. */
+	zassert_ok(co_mgr_request_guarding(&t.n[1].node, 0, 0x0A, true, req_con, NULL));
+	run_ms(50);
+	zassert_equal(n_con, 3);
+	zassert_equal(con_abort, CO_SDO_AB_DATA_DEV_STATE);
+	/* Refused locally. */
+	zassert_equal(co_mgr_request_nmt(&t.n[1].node, 0, 0x0A, 0x08, req_con, NULL), -EINVAL);
+	zassert_equal(co_mgr_request_nmt(&t.n[1].node, 0, 0, 0x05, req_con, NULL), -EINVAL);
+	zassert_equal(co_mgr_request_nmt(&t.n[0].node, 0, 0x0A, 0x05, req_con, NULL), -EPERM,
+		      "the active master writes its own 1F82h");
+}
+
+ZTEST(co_mgr_fm, test_request_nmt_without_a_known_master)
+{
+	candidate(0, 5, 1);
+	start_all();
+	run_ms(100);
+	zassert_equal(co_mgr_request_nmt(&t.n[0].node, 0, 0x0A, 0x05, req_con, NULL), -ENOENT);
+}
+
 ZTEST(co_mgr_fm, test_split_two_active_masters_resolve)
 {
 	uint64_t joined;
