@@ -151,9 +151,12 @@ static void publish(struct co_mgr *m, enum co_mgr_fm_event what)
  */
 static void reset_all(struct co_mgr *m)
 {
-	send(m, 0x000, 2, CO_NMT_CS_RESET_COMMUNICATION, 0x00);
-	/* Our controller does not receive its own frame. */
+	/*
+	 * Our controller does not receive its own frame, so we reset ourselves; first, since a
+	 * reset withdraws what the node still has queued (the frame could be held by a busy bus).
+	 */
 	(void)co_nmt_req(m->node, CO_NMT_CS_RESET_COMMUNICATION);
+	send(m, 0x000, 2, CO_NMT_CS_RESET_COMMUNICATION, 0x00);
 }
 
 static void hb_watch(struct co_mgr *m, uint8_t id)
