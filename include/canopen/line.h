@@ -174,8 +174,10 @@ struct co_timer {
 	sys_snode_t node;
 	uint64_t deadline;
 	struct co_line *line;
+	/* Bit 0: armed (in the line's list); bits 1-31: bumped by every start and stop. One
+	 * word for both keeps the timer at 32 bytes on a 32-bit target (40 with a bool).
+	 */
 	uint32_t gen;
-	bool armed;
 	/** @endcond */
 };
 

@@ -736,14 +736,16 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
 	timer->user_data = user_data;
 }
 
+/* co_timer.gen: bit 0 is set while the timer is in the line's list. */
+#define TIMER_ARMED 1U
+
 static void timer_unlink(struct co_line *line, struct co_timer *timer)
 {
-	/* Any start or stop makes a timer popped earlier stale. */
-	timer->gen++;
-	if (timer->armed) {
+	if ((timer->gen & TIMER_ARMED) != 0U) {
 		sys_slist_find_and_remove(&line->timers, &timer->node);
-		timer->armed = false;
 	}
+	/* Any start or stop makes a timer popped earlier stale: disarmed, count bumped. */
+	timer->gen = (timer->gen & ~TIMER_ARMED) + 2U;
 }
 
 void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us)
@@ -770,7 +772,7 @@ void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadl
 		prev = cur;
 	}
 	sys_slist_insert(&line->timers, prev, &timer->node);
-	timer->armed = true;
+	timer->gen |= TIMER_ARMED;
 	first = (prev == NULL);
 	k_mutex_unlock(&line->lock);
 
@@ -800,7 +802,7 @@ bool co_timer_is_armed(const struct co_timer *timer)
 		return false;
 	}
 	k_mutex_lock(&line->lock, K_FOREVER);
-	armed = timer->armed;
+	armed = (timer->gen & TIMER_ARMED) != 0U;
 	k_mutex_unlock(&line->lock);
 	return armed;
 }
@@ -832,7 +834,7 @@ static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us,
 
 		if (co_time_before_eq(first->deadline, now_us)) {
 			sys_slist_get_not_empty(&line->timers);
-			first->armed = false;
+			first->gen &= ~TIMER_ARMED;
 			*gen = first->gen;
 			t = first;
 		}

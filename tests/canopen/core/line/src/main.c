@@ -343,6 +343,69 @@ ZTEST(co_line, test_restart_replaces_the_deadline_and_stop_disarms)
 	co_timer_stop(&a.t); /* stopping twice is harmless */
 }
 
+static K_THREAD_STACK_DEFINE(processor_stack, 4096);
+static struct k_thread processor;
+
+/* The line thread's part: process the line at the time *p1. */
+static void process_at(void *p1, void *p2, void *p3)
+{
+	ARG_UNUSED(p2);
+	ARG_UNUSED(p3);
+	(void)co_line_process(&fx.line, *(const uint64_t *)p1);
+}
+
+/*
+ * Process the line at @p now in another thread while this one holds the timer's lock, and
+ * return once that thread has taken @p timer off the list (it then waits for the lock).
+ */
+static void process_while_locked(const struct co_timer *timer, const uint64_t *now)
+{
+	k_mutex_lock(&fx.node_lock, K_FOREVER);
+	k_thread_create(&processor, processor_stack, K_THREAD_STACK_SIZEOF(processor_stack),
+			process_at, (void *)now, NULL, NULL, K_PRIO_PREEMPT(1), 0, K_NO_WAIT);
+	for (int i = 0; i < 5000 && co_timer_is_armed(timer); i++) {
+		k_msleep(1);
+	}
+	zassert_false(co_timer_is_armed(timer), "the timer was taken off the list");
+}
+
+ZTEST(co_line, test_a_timer_changed_after_it_was_taken_off_the_list_does_not_run)
+{
+	static const uint64_t t2000 = 2000, t7000 = 7000;
+	struct tagged_timer a = {.tag = 1};
+
+	/*
+	 * The line thread takes a due timer off the list, then waits for the owner's lock;
+	 * the owner restarts or stops the timer meanwhile: it is not due any more.
+	 */
+	co_timer_init(&a.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_start(&fx.line, &a.t, 1000);
+	process_while_locked(&a.t, &t2000);
+	co_timer_start(&fx.line, &a.t, 4000);
+	zassert_true(co_timer_is_armed(&a.t));
+	k_mutex_unlock(&fx.node_lock);
+	zassert_ok(k_thread_join(&processor, K_SECONDS(5)));
+	zassert_equal(a.fired, 0, "restarted: not run at its old deadline");
+	zassert_true(co_timer_is_armed(&a.t), "armed for the new deadline");
+	zassert_equal(co_line_process(&fx.line, 4000), UINT64_MAX);
+	zassert_equal(a.fired, 1, "run at the new deadline");
+
+	co_timer_start(&fx.line, &a.t, 6000);
+	process_while_locked(&a.t, &t7000);
+	co_timer_stop(&a.t);
+	k_mutex_unlock(&fx.node_lock);
+	zassert_ok(k_thread_join(&processor, K_SECONDS(5)));
+	zassert_equal(a.fired, 1, "stopped: not run");
+	zassert_false(co_timer_is_armed(&a.t));
+	zassert_equal(co_line_process(&fx.line, 8000), UINT64_MAX);
+	zassert_equal(a.fired, 1);
+
+	/* Unchanged after it was taken off: it runs. */
+	co_timer_start(&fx.line, &a.t, 9000);
+	zassert_equal(co_line_process(&fx.line, 9000), UINT64_MAX);
+	zassert_equal(a.fired, 2);
+}
+
 ZTEST(co_line, test_periodic_timer_rearmed_from_its_handler_catches_up)
 {
 	struct tagged_timer hb = {.tag = 5, .rearm_period = 100};
