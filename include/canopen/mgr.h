@@ -332,6 +332,42 @@ struct co_mgr_fm {
 /** @endcond */
 #endif /* CONFIG_CANOPEN_MGR_FLYING */
 
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+/** @cond INTERNAL_HIDDEN */
+/* SDO manager (mgr_sdom.c): one write of an operation, a queued 1F00h/1F01h. */
+struct co_mgr_sdom_wr {
+	uint32_t val;
+	uint16_t index;
+	uint8_t sub;
+	uint8_t len;
+	uint8_t node;
+};
+
+struct co_mgr_sdom_req {
+	uint32_t val;
+	uint16_t kind; /* 1F00h, 1F01h, or an error code to report in the SRD's 1F10h */
+};
+
+struct co_mgr_sdom {
+	struct co_rx trig_rx; /* 6E0h */
+	struct co_mgr_sdom_wr wr[8];
+	struct co_mgr_sdom_req q[4];
+	uint8_t cpool[CONFIG_CANOPEN_MGR_SDOM_CONNS][2]; /* 1F02h subs of each 1F03h entry */
+	uint8_t srds[CONFIG_CANOPEN_MGR_SDOM_SRDS];      /* registered SRDs */
+	bool all[CONFIG_CANOPEN_MGR_SDOM_SRDS];          /* ... owning all default SDOs */
+	uint8_t buf[4];
+	uint32_t rel_val; /* the 1F01h value being carried out */
+	uint16_t idx;
+	uint8_t n_wr, i_wr, n_q;
+	uint8_t op, end, scan_id, srv_num, conn, slave, srd;
+	uint8_t pool[2];
+	bool rel_active;
+	bool trig;      /* a 6E0h came: scan when idle */
+	bool own_write; /* our writes of 1F02h/1F03h pass the hook */
+};
+/** @endcond */
+#endif /* CONFIG_CANOPEN_MGR_SDOM */
+
 /** @cond INTERNAL_HIDDEN */
 struct co_mgr;
 
@@ -442,6 +478,9 @@ struct co_mgr {
 #endif
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
 	struct co_mgr_lss lss; /* node-IDs for missing slaves by LSS (mgr_lss.c) */
+#endif
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+	struct co_mgr_sdom sdom; /* SDO manager (mgr_sdom.c) */
 #endif
 };
 /** @endcond */

@@ -150,6 +150,11 @@ static int mgr_init(struct co_node *node)
 		return -ENOSPC;
 	}
 #endif
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+	if (co_mgr_sdom_init(m) != 0) {
+		return -ENOSPC;
+	}
+#endif
 	return co_mgr_od_hooks_register(m);
 }
 

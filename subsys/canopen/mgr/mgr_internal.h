@@ -14,6 +14,7 @@
  * - mgr_startup.c  the NMT startup: reset, boot all, 1F89h, halt, start all / individual
  * - mgr_od.c       the hooks on 1F80h-1F83h and the 1F82h read value
  * - mgr_fm.c       flying master (1F90h) and NMT master detection (1F91h)
+ * - mgr_sdom.c     SDO manager: 6E0h registration, 1F00h-1F03h (dynamic SDO connections)
  *
  * Every function here runs with the node's mutex held.
  */
@@ -243,5 +244,12 @@ uint8_t co_mgr_pgm_time(struct co_mgr_slave *s);
 uint8_t co_mgr_pgm_time_sdo(struct co_mgr_slave *s, uint32_t ab);
 uint8_t co_mgr_pgm_resume(struct co_mgr_slave *s);
 uint8_t co_mgr_pgm_resume_sdo(struct co_mgr_slave *s, uint32_t ab);
+
+/* --- mgr_sdom.c: SDO manager ------------------------------------------------------------------ */
+
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+/* Receive 6E0h and hook 1F00h-1F03h. */
+int co_mgr_sdom_init(struct co_mgr *m);
+#endif
 
 #endif /* SAFELINE_SUBSYS_CANOPEN_MGR_MGR_INTERNAL_H_ */

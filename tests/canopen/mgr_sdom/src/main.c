@@ -1,0 +1,630 @@
+/*
+ * Copyright (c) 2026 SafeLine contributors
+ * SPDX-License-Identifier: Apache-2.0
+ */
+
+/*
+ * SDO manager (CiA 302 §7) on simulated time: a manager (node 01h), an SDO requesting
+ * device (SRD, node 7Eh), a slave with one free server SDO 1201h (0Ah) and a slave with only
+ * its default SDO (0Bh). Every node sits on its own simulation line; the test is the bus and
+ * hands each frame to every other live node. The SRD talks to the manager and to the slaves
+ * with its own SDO clients over the COB-IDs the manager handed out.
+ */
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <zephyr/sys/byteorder.h>
+#include <zephyr/ztest.h>
+
+#include <canopen/mgr.h>
+#include <canopen/node.h>
+#include <canopen/sdo_abort.h>
+#include <canopen/sdo_cli.h>
+#include <canopen/sdom.h>
+
+#include "line_internal.h"
+
+#include "sdom_mgr_od.h"
+#include "sdom_plain_od.h"
+#include "sdom_slave_od.h"
+#include "sdom_srd_od.h"
+
+#define MS       1000ULL
+#define MAX_NODE 5
+#define MAX_LOG  4096
+#define MAX_PEND 256
+#define MAX_CFG  16
+#define INJECTED (-1)
+
+#define MGR   0
+#define SRD   1
+#define SLV   2
+#define PLAIN 3
+
+#define ID_MGR   0x01U
+#define ID_SRD   0x7EU
+#define ID_SLV   0x0AU
+#define ID_PLAIN 0x0BU
+#define POOL0    0x6C0U
+
+struct cfg_entry {
+	uint16_t index;
+	uint8_t sub;
+	uint8_t len;
+	uint32_t value;
+};
+
+struct nd {
+	struct co_line line;
+	struct co_node node;
+	union {
+		struct sdom_mgr_od_ram m;
+		struct sdom_srd_od_ram r;
+		struct sdom_slave_od_ram s;
+		struct sdom_plain_od_ram p;
+	} ram;
+	struct cfg_entry cfg[MAX_CFG];
+	int n_cfg;
+	bool used;
+	bool alive;
+	char name[8];
+};
+
+struct logged {
+	struct can_frame f;
+	uint64_t at;
+	int from; /* node index, INJECTED */
+};
+
+static struct {
+	struct nd n[MAX_NODE];
+	struct logged log[MAX_LOG];
+	int n_log;
+	struct can_frame pend[MAX_PEND];
+	int pend_from[MAX_PEND];
+	int n_pend;
+	uint64_t now;
+} t;
+
+/* --- The bus -------------------------------------------------------------------------------- */
+
+static void bus_put(const struct can_frame *f, int from)
+{
+	zassert_true(t.n_log < MAX_LOG, "log full");
+	t.log[t.n_log++] = (struct logged){.f = *f, .at = t.now, .from = from};
+	zassert_true(t.n_pend < MAX_PEND);
+	t.pend[t.n_pend] = *f;
+	t.pend_from[t.n_pend++] = from;
+}
+
+static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
+{
+	int i = (int)(intptr_t)user_data;
+
+	ARG_UNUSED(line);
+	if (t.n[i].alive) {
+		bus_put(frame, i);
+	}
+	return 0;
+}
+
+/* Deliver what was sent, at the time it was sent, until nobody sends any more. */
+static void settle(void)
+{
+	for (int guard = 0; guard < 100000; guard++) {
+		bool did = false;
+
+		if (t.n_pend > 0) {
+			struct can_frame f = t.pend[0];
+			int from = t.pend_from[0];
+
+			memmove(&t.pend[0], &t.pend[1], (size_t)(t.n_pend - 1) * sizeof(t.pend[0]));
+			memmove(&t.pend_from[0], &t.pend_from[1],
+				(size_t)(t.n_pend - 1) * sizeof(t.pend_from[0]));
+			t.n_pend--;
+			for (int j = 0; j < MAX_NODE; j++) {
+				struct nd *d = &t.n[j];
+
+				if (j != from && d->used && d->alive) {
+					(void)co_line_rx(&d->line, &f, t.now);
+				}
+			}
+			did = true;
+		}
+		for (int j = 0; j < MAX_NODE; j++) {
+			if (t.n[j].used && t.n[j].alive &&
+			    k_msgq_num_used_get(&t.n[j].line.rxq) > 0U) {
+				co_line_process(&t.n[j].line, t.now);
+				did = true;
+			}
+		}
+		if (!did) {
+			return;
+		}
+	}
+	zassert_unreachable("the bus does not settle");
+}
+
+static void run_until(uint64_t at)
+{
+	settle();
+	for (int guard = 0; guard < 1000000; guard++) {
+		uint64_t next = UINT64_MAX;
+
+		for (int j = 0; j < MAX_NODE; j++) {
+			if (t.n[j].used && t.n[j].alive) {
+				uint64_t d = co_line_next_deadline(&t.n[j].line);
+
+				next = d < next ? d : next;
+			}
+		}
+		if (next > at) {
+			break;
+		}
+		if (next > t.now) {
+			t.now = next;
+		}
+		for (int j = 0; j < MAX_NODE; j++) {
+			if (t.n[j].used && t.n[j].alive) {
+				co_line_process(&t.n[j].line, t.now);
+			}
+		}
+		settle();
+	}
+	t.now = at;
+	for (int j = 0; j < MAX_NODE; j++) {
+		if (t.n[j].used && t.n[j].alive) {
+			co_line_process(&t.n[j].line, t.now);
+		}
+	}
+	settle();
+}
+
+static void run_ms(uint64_t ms)
+{
+	run_until(t.now + ms * MS);
+}
+
+static void inject(uint16_t id, uint8_t dlc, uint8_t b0, uint8_t b1)
+{
+	struct can_frame f = {.id = id, .dlc = dlc, .data = {b0, b1}};
+
+	bus_put(&f, INJECTED);
+	settle();
+}
+
+/* --- Nodes ----------------------------------------------------------------------------------- */
+
+static void restore(struct co_od *od, uint32_t group_mask, void *user_data)
+{
+	struct nd *d = user_data;
+
+	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) == 0U) {
+		return;
+	}
+	for (int i = 0; i < d->n_cfg; i++) {
+		uint8_t buf[4];
+
+		sys_put_le32(d->cfg[i].value, buf);
+		zassert_equal(co_od_write(od, d->cfg[i].index, d->cfg[i].sub, buf, d->cfg[i].len,
+					  CO_OD_WRITER_STORAGE),
+			      0U, "config %04x:%02x", d->cfg[i].index, d->cfg[i].sub);
+	}
+}
+
+static void cfg(int i, uint16_t index, uint8_t sub, uint32_t value, uint8_t len)
+{
+	struct nd *d = &t.n[i];
+
+	zassert_true(d->n_cfg < MAX_CFG);
+	d->cfg[d->n_cfg++] = (struct cfg_entry){index, sub, len, value};
+}
+
+static void node_add(int i, uint8_t id, const struct co_od_def *def)
+{
+	struct nd *d = &t.n[i];
+
+	d->used = true;
+	d->alive = true;
+	snprintf(d->name, sizeof(d->name), "n%02x", id);
+	co_line_init_sim(&d->line, d->name, sink, (void *)(intptr_t)i);
+	zassert_ok(co_node_init(&d->node, d->name, &d->line, def, &d->ram, id));
+	co_od_set_restore_cb(co_node_od(&d->node), restore, d);
+}
+
+static uint32_t od_u(int i, uint16_t index, uint8_t sub)
+{
+	uint32_t v;
+
+	co_node_lock(&t.n[i].node);
+	v = co_od_uint(co_node_od(&t.n[i].node), index, sub, 0);
+	co_node_unlock(&t.n[i].node);
+	return v;
+}
+
+static uint32_t od_w(int i, uint16_t index, uint8_t sub, uint32_t v, enum co_od_writer who)
+{
+	uint8_t b[4];
+	uint32_t ab;
+
+	sys_put_le32(v, b);
+	co_node_lock(&t.n[i].node);
+	ab = co_od_write(co_node_od(&t.n[i].node), index, sub, b, 4, who);
+	co_node_unlock(&t.n[i].node);
+	settle();
+	return ab;
+}
+
+/* Manager with a pool of @p pool COB-IDs from 6C0h; all four nodes started and settled. */
+static void network(int pool)
+{
+	node_add(MGR, ID_MGR, &sdom_mgr_od_def);
+	node_add(SRD, ID_SRD, &sdom_srd_od_def);
+	node_add(SLV, ID_SLV, &sdom_slave_od_def);
+	node_add(PLAIN, ID_PLAIN, &sdom_plain_od_def);
+	cfg(MGR, 0x1F80, 0, 0x01, 4);
+	for (int k = 0; k < pool; k++) {
+		cfg(MGR, 0x1F02, (uint8_t)(k + 1), POOL0 + (uint32_t)k, 4);
+	}
+	for (int i = 0; i < MAX_NODE; i++) {
+		if (t.n[i].used) {
+			zassert_ok(co_node_start(&t.n[i].node));
+		}
+	}
+	/* The manager's startup resets the others (Reset Communication); let it end. */
+	run_ms(2000);
+}
+
+/* --- The SRD's SDO client ------------------------------------------------------------------- */
+
+static struct {
+	bool done;
+	uint32_t ab;
+	size_t size;
+	uint8_t buf[8];
+} sdo;
+
+static void sdo_con(struct co_sdo_cli *cli, uint32_t ab, size_t size, void *user_data)
+{
+	ARG_UNUSED(cli);
+	ARG_UNUSED(user_data);
+	sdo.done = true;
+	sdo.ab = ab;
+	sdo.size = size;
+}
+
+/* Download @p v to @p index:@p sub over the SRD's client @p num; the abort code. */
+static uint32_t srd_download(uint8_t num, uint16_t index, uint8_t sub, uint32_t v)
+{
+	struct co_node *n = &t.n[SRD].node;
+	int err;
+
+	memset(&sdo, 0, sizeof(sdo));
+	sys_put_le32(v, sdo.buf);
+	co_node_lock(n);
+	err = co_sdo_cli_download_req(co_sdo_cli_get(n, num), index, sub, sdo.buf, 4,
+				      CO_SDO_CLI_AUTO, 100, sdo_con, NULL);
+	co_node_unlock(n);
+	zassert_ok(err);
+	run_ms(300);
+	zassert_true(sdo.done);
+	return sdo.ab;
+}
+
+static uint32_t srd_upload(uint8_t num, uint16_t index, uint8_t sub, uint32_t *v)
+{
+	struct co_node *n = &t.n[SRD].node;
+	int err;
+
+	memset(&sdo, 0, sizeof(sdo));
+	co_node_lock(n);
+	err = co_sdo_cli_upload_req(co_sdo_cli_get(n, num), index, sub, sdo.buf, sizeof(sdo.buf),
+				    CO_SDO_CLI_AUTO, 100, sdo_con, NULL);
+	co_node_unlock(n);
+	zassert_ok(err);
+	run_ms(300);
+	zassert_true(sdo.done);
+	*v = sys_get_le32(sdo.buf);
+	return sdo.ab;
+}
+
+/* Whether a frame with CAN-ID @p id was on the bus since @p since. */
+static bool seen(uint32_t id, uint64_t since)
+{
+	for (int i = 0; i < t.n_log; i++) {
+		if (t.log[i].at >= since && t.log[i].f.id == id) {
+			return true;
+		}
+	}
+	return false;
+}
+
+/* The SRD registers with client entry 1280h (1F10h = 12800001h, then 6E0#). */
+static void srd_register(uint32_t req)
+{
+	zassert_equal(od_w(SRD, 0x1F10, 0, req, CO_OD_WRITER_APP), 0U);
+	inject(0x6E0, 0, 0, 0);
+	/* Node-ID 7Fh is absent (scan timeout), 7Eh answers. */
+	run_ms(1000);
+}
+
+static uint32_t conn(uint8_t sub)
+{
+	return od_u(MGR, 0x1F03, sub);
+}
+
+#define REQ(idx, srd, s) (((uint32_t)(idx) << 16) | ((uint32_t)(srd) << 8) | (s))
+
+static void before(void *unused)
+{
+	ARG_UNUSED(unused);
+	memset(&t, 0, sizeof(t));
+}
+
+/* SAFELINE_SDOM_TRACE=1 prints every frame of each test (reading a failure). */
+static void after(void *unused)
+{
+	const char *e = getenv("SAFELINE_SDOM_TRACE");
+
+	ARG_UNUSED(unused);
+	if (e != NULL && e[0] == '1') {
+		for (int i = 0; i < t.n_log; i++) {
+			const struct can_frame *f = &t.log[i].f;
+
+			printf("%10llu %3x [%u] %02x %02x %02x %02x %02x %02x %02x %02x\n",
+			       (unsigned long long)t.log[i].at, f->id, f->dlc, f->data[0],
+			       f->data[1], f->data[2], f->data[3], f->data[4], f->data[5],
+			       f->data[6], f->data[7]);
+		}
+	}
+}
+
+/* --- Tests ------------------------------------------------------------------------------------ */
+
+/* 302 §7.2.1: scan from 7Fh down, pair from 1F02h, SRD's 1280h, our 1201h, 1F03h, 1F10h. */
+ZTEST(co_mgr_sdom, test_registration)
+{
+	uint32_t v;
+	uint64_t t0;
+
+	network(6);
+	t0 = t.now;
+	srd_register(0x12800001U);
+	zassert_true(seen(0x600U + 0x7FU, t0), "7Fh scanned first");
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "Rq 0, state 1, index 1280h");
+	zassert_equal(od_u(SRD, 0x1280, 1), POOL0);
+	zassert_equal(od_u(SRD, 0x1280, 2), POOL0 + 1U);
+	zassert_equal(od_u(SRD, 0x1280, 3), ID_MGR);
+	zassert_equal(od_u(MGR, 0x1201, 1), POOL0);
+	zassert_equal(od_u(MGR, 0x1201, 2), POOL0 + 1U);
+	zassert_equal(od_u(MGR, 0x1201, 3), ID_SRD);
+	zassert_equal(od_u(MGR, 0x1F02, 1), POOL0 | BIT(30));
+	zassert_equal(od_u(MGR, 0x1F02, 2), (POOL0 + 1U) | BIT(30));
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
+	zassert_equal(conn(1), ((uint32_t)ID_SRD << 16) | (1U << 8) | ID_MGR, "offsets 0 and 1");
+	/* The channel works: the SRD reads the manager's pool through 6C0h/6C1h. */
+	t0 = t.now;
+	zassert_equal(srd_upload(0, 0x1F02, 3, &v), 0U);
+	zassert_equal(v, POOL0 + 2U);
+	zassert_true(seen(POOL0, t0) && seen(POOL0 + 1U, t0));
+}
+
+ZTEST(co_mgr_sdom, test_registration_all_default_sdos)
+{
+	network(6);
+	srd_register(0x00000003U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000004U, "state 2");
+	zassert_equal(od_u(MGR, 0x1F02, 1), POOL0, "nothing allocated");
+	zassert_equal(conn(1), 0U);
+}
+
+ZTEST(co_mgr_sdom, test_registration_pool_empty)
+{
+	network(1);
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000100U, "state 0, error 01h");
+	zassert_equal(conn(1), 0U);
+}
+
+/* The slave's default SDO is free: only the table and the SRD's client entry change. */
+ZTEST(co_mgr_sdom, test_connection_default_sdo)
+{
+	uint32_t v;
+	uint64_t t0;
+
+	network(6);
+	srd_register(0x12800001U);
+	t0 = t.now;
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12810006U, "state 3, index 1281h");
+	zassert_equal(od_u(SRD, 0x1281, 1), 0x600U + ID_SLV);
+	zassert_equal(od_u(SRD, 0x1281, 2), 0x580U + ID_SLV);
+	zassert_equal(od_u(SRD, 0x1281, 3), ID_SLV);
+	zassert_equal(conn(2), ((uint32_t)1 << 24) | ((uint32_t)ID_SRD << 16) | ID_SLV);
+	zassert_equal(od_u(SLV, 0x1201, 1), 0x80000000U, "nothing written to S");
+	zassert_false(seen(0x600U + ID_SLV, t0), "the manager does not talk to S");
+	zassert_equal(srd_upload(1, 0x2000, 0, &v), 0U);
+	zassert_equal(v, 0x12345678U);
+}
+
+/* The default SDO is taken: a free server entry on S, COB-IDs from the pool. */
+ZTEST(co_mgr_sdom, test_connection_dynamic)
+{
+	uint32_t v;
+	uint64_t t0;
+
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12820006U);
+	zassert_equal(od_u(SLV, 0x1201, 1), POOL0 + 2U);
+	zassert_equal(od_u(SLV, 0x1201, 2), POOL0 + 3U);
+	zassert_equal(od_u(SLV, 0x1201, 3), ID_SRD);
+	zassert_equal(od_u(SRD, 0x1282, 1), POOL0 + 2U);
+	zassert_equal(od_u(SRD, 0x1282, 2), POOL0 + 3U);
+	zassert_equal(od_u(SRD, 0x1282, 3), ID_SLV);
+	zassert_equal(od_u(MGR, 0x1F02, 3), (POOL0 + 2U) | BIT(30));
+	zassert_equal(conn(3), ((uint32_t)2 << 24) | ((uint32_t)ID_SRD << 16) | (1U << 8) | ID_SLV);
+	/* The SRD really talks to S through 6C2h/6C3h. */
+	t0 = t.now;
+	zassert_equal(srd_download(2, 0x2000, 0, 0xCAFEF00DU), 0U);
+	zassert_equal(od_u(SLV, 0x2000, 0), 0xCAFEF00DU);
+	zassert_true(seen(POOL0 + 2U, t0) && seen(POOL0 + 3U, t0));
+	zassert_false(seen(0x600U + ID_SLV, t0));
+	zassert_equal(srd_upload(2, 0x2000, 0, &v), 0U);
+	zassert_equal(v, 0xCAFEF00DU);
+}
+
+ZTEST(co_mgr_sdom, test_pool_exhausted)
+{
+	network(4);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1283, ID_SRD, ID_SLV)),
+		      CO_SDO_AB_NO_RESOURCE);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000200U, "state 0, error 02h");
+}
+
+ZTEST(co_mgr_sdom, test_no_free_server_entry)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_PLAIN)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_PLAIN)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000300U, "state 0, error 03h");
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U, "pair not taken");
+	zassert_equal(conn(3), 0U);
+}
+
+ZTEST(co_mgr_sdom, test_slave_absent)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, 0x20)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, 0x20)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U, "state 0, error 04h");
+}
+
+ZTEST(co_mgr_sdom, test_release_one_and_all_to_slave)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(conn(3), 0U);
+	zassert_not_equal(conn(2), 0U, "the other connection stays");
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U, "bit 30 cleared");
+	zassert_equal(od_u(MGR, 0x1F02, 4), POOL0 + 3U);
+	/* Index 0: every connection to S. */
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(conn(2), 0U);
+	zassert_equal(conn(3), 0U);
+	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
+	zassert_not_equal(conn(1), 0U, "still registered");
+}
+
+ZTEST(co_mgr_sdom, test_deregistration)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	/* Slave 0: all released, the SRD's own channel last (the write is confirmed first). */
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, 0)), 0U);
+	for (uint8_t i = 1; i <= 6; i++) {
+		zassert_equal(conn(i), 0U, "1F03h:%u", i);
+		zassert_equal(od_u(MGR, 0x1F02, i), POOL0 + i - 1U, "1F02h:%u", i);
+	}
+	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SRD, 0x1280, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
+	/* No longer registered: a request is refused. */
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE);
+	/* It may register again. */
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
+}
+
+ZTEST(co_mgr_sdom, test_wrong_values_refused)
+{
+	network(6);
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE, "SRD not registered");
+	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_INVALID_VALUE, "release by an unknown SRD");
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, 0)), CO_SDO_AB_NO_RESOURCE,
+		      "slave 0");
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1000, ID_SRD, ID_SLV)),
+		      CO_SDO_AB_NO_RESOURCE, "not a client entry");
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000100U);
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1000, ID_SRD, ID_SLV)),
+		      CO_SDO_AB_INVALID_VALUE);
+	zassert_equal(srd_download(0, 0x1F03, 1, 0), CO_SDO_AB_READONLY);
+	zassert_equal(srd_download(0, 0x1F02, 5, 0x6D0), CO_SDO_AB_DATA_DEV_STATE,
+		      "pool rewritten while connections are open");
+}
+
+/* The SRD's helpers (include/canopen/sdom.h): register, status, request, release. */
+ZTEST(co_mgr_sdom, test_srd_helpers)
+{
+	struct co_sdom_srd srd;
+	struct co_sdom_status st;
+	struct co_node *n;
+	uint32_t v;
+	uint64_t t0;
+
+	network(6);
+	n = &t.n[SRD].node;
+	co_node_lock(n);
+	zassert_equal(co_sdom_srd_register(&srd, n, 0x1000), -EINVAL);
+	zassert_ok(co_sdom_srd_register(&srd, n, 0x1280));
+	zassert_ok(co_sdom_srd_status(&srd, &st));
+	co_node_unlock(n);
+	zassert_true(st.pending);
+	t0 = t.now;
+	settle();
+	zassert_true(seen(0x6E0U, t0), "the SRD sent 6E0h");
+	run_ms(1000);
+	co_node_lock(n);
+	zassert_ok(co_sdom_srd_status(&srd, &st));
+	zassert_false(st.pending);
+	zassert_equal(st.state, CO_SDOM_REGISTERED);
+	zassert_equal(st.index, 0x1280);
+	zassert_equal(co_sdom_srd_request(&srd, 0x1281, 0, sdo_con, NULL), -EINVAL);
+	memset(&sdo, 0, sizeof(sdo));
+	zassert_ok(co_sdom_srd_request(&srd, 0x1281, ID_SLV, sdo_con, NULL));
+	co_node_unlock(n);
+	run_ms(300);
+	zassert_true(sdo.done);
+	zassert_equal(sdo.ab, 0U);
+	co_node_lock(n);
+	zassert_ok(co_sdom_srd_status(&srd, &st));
+	co_node_unlock(n);
+	zassert_equal(st.state, CO_SDOM_CONNECTED);
+	zassert_equal(st.index, 0x1281);
+	zassert_equal(srd_upload(1, 0x2000, 0, &v), 0U);
+	zassert_equal(v, 0x12345678U);
+	co_node_lock(n);
+	memset(&sdo, 0, sizeof(sdo));
+	zassert_ok(co_sdom_srd_release(&srd, 0, 0, sdo_con, NULL));
+	co_node_unlock(n);
+	run_ms(300);
+	zassert_equal(sdo.ab, 0U);
+	zassert_equal(conn(1), 0U);
+	zassert_equal(conn(2), 0U);
+	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
+}
+
+ZTEST_SUITE(co_mgr_sdom, NULL, NULL, before, after, NULL);
