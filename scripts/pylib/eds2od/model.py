@@ -498,8 +498,10 @@ class Builder:
         for o in objects:
             if not (0x1600 <= o.index <= 0x17FF or 0x1A00 <= o.index <= 0x1BFF):
                 continue
-            n = o.subs[0].default.v if o.subs and o.subs[0].sub == 0 and o.subs[0].default \
-                is not None and not o.subs[0].default.rel else 0x40
+            d0 = o.subs[0].default if o.subs and o.subs[0].sub == 0 else None
+            # Sub-index 0 of another type than a number (a fuzzed VISIBLE_STRING) counts as
+            # "all": its own type is checked elsewhere.
+            n = d0.v if d0 is not None and not d0.rel and isinstance(d0.v, int) else 0x40
             for s in o.subs[1:]:
                 d = s.default
                 if s.sub > n or d is None or d.rel or s.dtype.code != 0x0007 or d.v == 0:

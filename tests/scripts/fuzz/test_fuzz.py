@@ -123,3 +123,16 @@ def test_eds2od_names_the_file_on_every_line_of_python_canopen_messages(name, tm
     assert any("python-canopen" in line for line in lines), r.stderr
     for line in lines:
         assert line.startswith(f"{path}:") or line.startswith("eds2od: "), line
+
+
+def test_eds2od_refuses_a_pdo_mapping_count_that_is_not_a_number(tmp_path):
+    """Found by the eds2od harness: 1600h sub 0 typed VISIBLE_STRING raised a TypeError in the
+    mapping check instead of the error about sub-index 0's type."""
+    src = os.path.join(EDS_HARNESS_DIR, "regressions", "pdo-mapping-count-not-a-number.dcf")
+    path = tmp_path / "slave.dcf"
+    path.write_bytes(open(src, "rb").read())
+    r = subprocess.run([sys.executable, os.path.join(BASE, "scripts", "eds2od"), str(path),
+                        "-o", str(tmp_path / "out")], capture_output=True, text=True)
+    assert r.returncode == 1, r.stderr
+    assert "Traceback" not in r.stderr
+    assert f"{path}:213: sub-index 0 of 1600h must be UNSIGNED8" in r.stderr
