@@ -350,6 +350,7 @@ struct co_mgr_sdom_req {
 
 struct co_mgr_sdom {
 	struct co_rx trig_rx; /* 6E0h */
+	struct co_timer work; /* runs what waits once a step has ended (mgr_sdom.c) */
 	struct co_mgr_sdom_wr wr[8];
 	struct co_mgr_sdom_req q[4];
 	uint8_t cpool[CONFIG_CANOPEN_MGR_SDOM_CONNS][2]; /* 1F02h subs of each 1F03h entry */
@@ -357,6 +358,7 @@ struct co_mgr_sdom {
 	bool all[CONFIG_CANOPEN_MGR_SDOM_SRDS];          /* ... owning all default SDOs */
 	uint8_t buf[4];
 	uint32_t rel_val; /* the 1F01h value being carried out */
+	uint32_t fake_ab; /* a request that could not start: its abort, for the timer */
 	uint16_t idx;
 	uint8_t n_wr, i_wr, n_q;
 	uint8_t op, end, scan_id, srv_num, conn, slave, srd;
