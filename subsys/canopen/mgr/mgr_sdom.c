@@ -48,6 +48,7 @@ LOG_MODULE_REGISTER(co_mgr_sdom, CONFIG_CANOPEN_LOG_LEVEL);
 enum {
 	OP_NONE,
 	OP_SCAN,
+	OP_PROBE,
 	OP_SEARCH,
 	OP_WRITE
 };
@@ -56,7 +57,8 @@ enum {
 enum {
 	END_REG,
 	END_CONN,
-	END_REL
+	END_REL,
+	END_STATUS
 };
 
 static struct co_sdo_cli *cli(struct co_mgr *m)
@@ -260,6 +262,62 @@ static void use_pair(struct co_mgr *m)
 	}
 }
 
+/* S's default SDO: the table and the SRD's client entry; nothing is written to S. */
+static void conn_default(struct co_mgr *m)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	od_put32(m, IDX_CONN, d->conn,
+		 ((uint32_t)(d->idx - IDX_CLI_PAR) << 24) | ((uint32_t)d->srd << 16) | d->slave);
+	d->srv_num = 0U;
+	d->n_wr = 0U;
+	d->i_wr = 0U;
+	d->end = END_CONN;
+	add_wr(m, d->srd, d->idx, 3U, d->slave, 1U);
+	add_wr(m, d->srd, d->idx, 1U, 0x600U + d->slave, 4U);
+	add_wr(m, d->srd, d->idx, 2U, 0x580U + d->slave, 4U);
+	add_status(m, d->srd, ((uint32_t)d->idx << 16) | ST_STATE(3));
+	d->op = OP_WRITE;
+	step_write(m);
+}
+
+/*
+ * A write of a set-up was refused (e.g. the SRD has no such client entry): the table entry
+ * and its pool pair are freed, what S or we got is invalidated, a registration is forgotten,
+ * and the SRD's 1F10h says state 0, error 00h (unspecified).
+ */
+static void undo(struct co_mgr *m)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+	uint8_t end = d->end;
+
+	od_put32(m, IDX_CONN, d->conn, 0U);
+	for (int k = 0; k < 2; k++) {
+		if (d->cpool[d->conn - 1U][k] != 0U) {
+			pool_mark(m, d->cpool[d->conn - 1U][k], false);
+			d->cpool[d->conn - 1U][k] = 0U;
+		}
+	}
+	d->n_wr = 0U;
+	d->i_wr = 0U;
+	d->end = END_STATUS;
+	if (end == END_REG) {
+		int i = srd_find(m, d->srd);
+
+		if (i >= 0) {
+			d->srds[i] = 0U;
+		}
+		add_wr(m, own_id(m), IDX_SRV_PAR + d->srv_num, 1U, COB_INVALID, 4U);
+		add_wr(m, own_id(m), IDX_SRV_PAR + d->srv_num, 2U, COB_INVALID, 4U);
+	} else if (d->srv_num != 0U) {
+		add_wr(m, d->slave, IDX_SRV_PAR + d->srv_num, 1U, COB_INVALID, 4U);
+		add_wr(m, d->slave, IDX_SRV_PAR + d->srv_num, 2U, COB_INVALID, 4U);
+	}
+	add_status(m, d->srd, 0U);
+	d->op = OP_WRITE;
+	step_write(m);
+}
+
 /* A dynamic connection: server entry on S, client entry on the SRD, table, confirmation. */
 static void conn_dynamic(struct co_mgr *m, uint8_t num)
 {
@@ -293,7 +351,7 @@ static void status_only(struct co_mgr *m, uint8_t srd, uint32_t v)
 
 	d->n_wr = 0U;
 	d->i_wr = 0U;
-	d->end = END_CONN;
+	d->end = END_STATUS;
 	add_status(m, srd, v);
 	d->op = OP_WRITE;
 	step_write(m);
@@ -345,6 +403,8 @@ static void registered(struct co_mgr *m, uint8_t id, uint32_t v)
 	}
 	d->srds[slot] = id;
 	d->all[slot] = false;
+	d->srd = id;
+	d->srv_num = srv;
 	use_pair(m);
 	od_put32(m, IDX_CONN, d->conn,
 		 ((uint32_t)(idx - IDX_CLI_PAR) << 24) | ((uint32_t)id << 16) |
@@ -399,6 +459,13 @@ static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data)
 		}
 		scan_from(m, (uint8_t)(d->scan_id - 1U));
 		return;
+	case OP_PROBE:
+		if (ab == 0U) {
+			conn_default(m);
+		} else {
+			fail(m, d->srd, 0x04U);
+		}
+		return;
 	case OP_SEARCH:
 		if (ab == 0U && (v & COB_INVALID) != 0U) {
 			conn_dynamic(m, d->srv_num);
@@ -419,6 +486,10 @@ static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data)
 
 			LOG_WRN("SDO manager: %u %04x:%02x refused (%08x)", w->node, w->index,
 				w->sub, ab);
+			if ((d->end == END_CONN || d->end == END_REG) && w->index != IDX_SRD_STAT) {
+				undo(m);
+				return;
+			}
 		}
 		d->i_wr++;
 		step_write(m);
@@ -482,19 +553,9 @@ static void request(struct co_mgr *m, uint32_t v)
 		return;
 	}
 	if (!default_taken(m, d->slave)) {
-		/* S's default SDO: nothing is written to S. */
-		od_put32(m, IDX_CONN, d->conn,
-			 ((uint32_t)(d->idx - IDX_CLI_PAR) << 24) | ((uint32_t)d->srd << 16) |
-				 d->slave);
-		d->n_wr = 0U;
-		d->i_wr = 0U;
-		d->end = END_CONN;
-		add_wr(m, d->srd, d->idx, 3U, d->slave, 1U);
-		add_wr(m, d->srd, d->idx, 1U, 0x600U + d->slave, 4U);
-		add_wr(m, d->srd, d->idx, 2U, 0x580U + d->slave, 4U);
-		add_status(m, d->srd, ((uint32_t)d->idx << 16) | ST_STATE(3));
-		d->op = OP_WRITE;
-		step_write(m);
+		/* S must answer on its default SDO (1000h) before the SRD gets it. */
+		d->op = OP_PROBE;
+		start_upload(m, d->slave, IDX_DEVTYPE, 0U);
 		return;
 	}
 	if (!pool_find(m, d->pool)) {
@@ -579,6 +640,10 @@ static uint32_t req_validate(struct co_od *od, struct co_od_req *req, void *user
 	if (req->len != 4U) {
 		return CO_SDO_AB_TYPE_MISMATCH;
 	}
+	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
+		/* Only the manager (1F80h bit 0) hands out connections. */
+		return CO_SDO_AB_DATA_DEV_STATE;
+	}
 	if (i < 0 || m->sdom.all[i]) {
 		/* Not registered (or it owns every default SDO already): nobody to tell. */
 		return CO_SDO_AB_NO_RESOURCE;
@@ -607,6 +672,10 @@ static uint32_t rel_validate(struct co_od *od, struct co_od_req *req, void *user
 	ARG_UNUSED(od);
 	if (req->len != 4U) {
 		return CO_SDO_AB_TYPE_MISMATCH;
+	}
+	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
+		/* Only the manager (1F80h bit 0) hands out connections. */
+		return CO_SDO_AB_DATA_DEV_STATE;
 	}
 	if (srd_find(m, (uint8_t)(v >> 8)) < 0 || (uint8_t)v > 127U ||
 	    (idx != 0U && (idx < IDX_CLI_PAR || idx > 0x12FFU))) {

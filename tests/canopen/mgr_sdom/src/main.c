@@ -342,6 +342,18 @@ static bool seen(uint32_t id, uint64_t since)
 	return false;
 }
 
+/* Whether an SDO download was started on CAN-ID @p id since @p since (CiA 301 ccs 1). */
+static bool seen_download(uint32_t id, uint64_t since)
+{
+	for (int i = 0; i < t.n_log; i++) {
+		if (t.log[i].at >= since && t.log[i].f.id == id &&
+		    (t.log[i].f.data[0] & 0xE0U) == 0x20U) {
+			return true;
+		}
+	}
+	return false;
+}
+
 /* The SRD registers with client entry 1280h (1F10h = 12800001h, then 6E0#). */
 static void srd_register(uint32_t req)
 {
@@ -445,7 +457,8 @@ ZTEST(co_mgr_sdom, test_connection_default_sdo)
 	zassert_equal(od_u(SRD, 0x1281, 3), ID_SLV);
 	zassert_equal(conn(2), ((uint32_t)1 << 24) | ((uint32_t)ID_SRD << 16) | ID_SLV);
 	zassert_equal(od_u(SLV, 0x1201, 1), 0x80000000U, "nothing written to S");
-	zassert_false(seen(0x600U + ID_SLV, t0), "the manager does not talk to S");
+	zassert_true(seen(0x600U + ID_SLV, t0), "the manager checks that S answers");
+	zassert_false(seen_download(0x600U + ID_SLV, t0), "but writes nothing to S");
 	zassert_equal(srd_upload(1, 0x2000, 0, &v), 0U);
 	zassert_equal(v, 0x12345678U);
 }
@@ -501,13 +514,38 @@ ZTEST(co_mgr_sdom, test_no_free_server_entry)
 	zassert_equal(conn(3), 0U);
 }
 
+/* S must answer on its default SDO before the SRD gets it (error 04h otherwise). */
 ZTEST(co_mgr_sdom, test_slave_absent)
 {
 	network(6);
 	srd_register(0x12800001U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, 0x20)), 0U);
-	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, 0x20)), 0U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U, "state 0, error 04h");
+	zassert_equal(conn(2), 0U);
+	zassert_equal(od_u(SRD, 0x1281, 1), 0x80000000U, "the SRD's entry untouched");
+}
+
+/* A refused write while setting up (the SRD has no 1283h) undoes what was done. */
+ZTEST(co_mgr_sdom, test_refused_write_undone)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1283, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000000U, "state 0, error 00h");
+	zassert_equal(conn(2), 0U);
+	/* The same over a dynamic entry: S's entry and the pool pair are given back. */
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12810006U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1283, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000000U);
+	zassert_equal(conn(3), 0U);
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
+	zassert_equal(od_u(MGR, 0x1F02, 4), POOL0 + 3U);
+	/* Still registered, and the pair serves the next request. */
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12820006U);
+	zassert_equal(od_u(SLV, 0x1201, 1), POOL0 + 2U);
 }
 
 ZTEST(co_mgr_sdom, test_release_one_and_all_to_slave)
@@ -574,6 +612,32 @@ ZTEST(co_mgr_sdom, test_wrong_values_refused)
 	zassert_equal(srd_download(0, 0x1F03, 1, 0), CO_SDO_AB_READONLY);
 	zassert_equal(srd_download(0, 0x1F02, 5, 0x6D0), CO_SDO_AB_DATA_DEV_STATE,
 		      "pool rewritten while connections are open");
+	/* Not the manager (1F80h bit 0 clear): no connections handed out. */
+	zassert_equal(od_w(MGR, 0x1F80, 0, 0, CO_OD_WRITER_APP), 0U);
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_DATA_DEV_STATE);
+	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_DATA_DEV_STATE);
+}
+
+/* While a request runs, four more wait; the next one is refused. */
+ZTEST(co_mgr_sdom, test_queue_full)
+{
+	network(6);
+	srd_register(0x12800001U);
+	/* The first one waits for the absent node 20h to answer (SDO timeout). */
+	for (int k = 0; k < 5; k++) {
+		zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, 0x20), CO_OD_WRITER_SDO), 0U,
+			      "request %d", k);
+	}
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, 0x20), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE);
+	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0x20), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE);
+	/* All five end (error 04h each); the queue takes requests again. */
+	run_ms(1000);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U);
+	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0x20), CO_OD_WRITER_SDO), 0U);
 }
 
 /* The SRD's helpers (include/canopen/sdom.h): register, status, request, release. */
