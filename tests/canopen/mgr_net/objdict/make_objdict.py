@@ -10,7 +10,7 @@ net_slave.dcf   the same with ParameterValues: the 20-entry concise DCF the mana
 
 Run it again after changing the numbers below; the files are checked in:
     make_objdict.py                                  (tests/canopen/mgr_net/objdict)
-    make_objdict.py --hb-ms 100 --out ../../mgr/bench/objdict
+    make_objdict.py --hb-ms 100 --hb-consumer-ms 10000 --out ../../mgr/bench/objdict
 """
 
 import argparse
@@ -28,6 +28,7 @@ SERIAL = 0x5AFE0001
 # Slave heartbeat period (set by the concise DCF) and the manager's consumer time (3 periods).
 # 126 slaves at 500 ms stay far below what the virtual bus carries under ThreadSanitizer.
 HB_PRODUCER_MS = 500
+HB_CONSUMER_MS = None  # None: 3 periods
 CFG_WORDS = 19  # 2200h:01..13h, plus 1017h = 20 entries
 
 HEADER = """[FileInfo]
@@ -144,6 +145,10 @@ class Dict:
         self.sub(0x1200, 2, "COB-ID server to client", 7, "ro", "$NODEID+0x580")
 
 
+def consumer_ms():
+    return 3 * HB_PRODUCER_MS if HB_CONSUMER_MS is None else HB_CONSUMER_MS
+
+
 def master():
     d = Dict()
     d.identity(0x302, 0x00010000, 1)
@@ -151,7 +156,7 @@ def master():
     d.sub(0x1016, 0, "Highest sub-index supported", 5, "ro", str(len(SLAVES)))
     for i, n in enumerate(SLAVES):
         d.sub(0x1016, i + 1, f"Consumer heartbeat time {i + 1}", 7, "rw", "0x00000000",
-              f"0x{(n << 16) | (3 * HB_PRODUCER_MS):08X}")
+              f"0x{(n << 16) | consumer_ms():08X}")
     d.var(0x1017, "Producer heartbeat time", 6, "rw", "0", "1000")
     d.record(0x1029, "Error behaviour", 2, 8)
     d.sub(0x1029, 0, "Highest sub-index supported", 5, "ro", "1")
@@ -204,9 +209,14 @@ def slave(dcf):
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("--hb-ms", type=int, default=HB_PRODUCER_MS, help="slave heartbeat period")
+ap.add_argument("--hb-consumer-ms", type=int, default=None,
+                help="the manager's heartbeat consumer time (default: 3 periods)")
 ap.add_argument("--out", default=HERE, help="output folder")
 args = ap.parse_args()
 HB_PRODUCER_MS = args.hb_ms
+HB_CONSUMER_MS = args.hb_consumer_ms
+if HB_CONSUMER_MS is not None and not 0 < HB_CONSUMER_MS <= 0xFFFF:
+    ap.error("--hb-consumer-ms: 1..65535 (1016h holds 16 bits of milliseconds)")
 for name, text in (("net_master.dcf", master()), ("net_slave.eds", slave(False)),
                    ("net_slave.dcf", slave(True))):
     with open(os.path.join(args.out, name), "w") as f:

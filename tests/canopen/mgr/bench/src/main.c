@@ -79,6 +79,44 @@ static atomic_t op_target;
 static uint64_t last_op_us; /* written by the slave that completes the count */
 static enum co_mgr_startup startup_result;
 
+/*
+ * What happened during a run besides the boots, printed when a run fails so that a failure
+ * says why: heartbeat losses the manager saw, boot attempts that ended with an error (the
+ * first one kept), line queue overruns and overflows.
+ */
+static atomic_t hb_lost;
+static atomic_t boot_errors;
+static atomic_t line_events;
+static struct co_mgr_boot_error first_err; /* under the manager's lock */
+
+/*
+ * How far each line thread runs behind: a timer on every line asks to run every 10 ms and
+ * notes how late it ran, the longest of the run over all lines. Slaves, bus and manager
+ * share one host process; when the host gives them less CPU than the boot needs (a loaded
+ * machine), the line threads fall behind real time, and a lag near a protocol timeout of the
+ * boot (SDO, heartbeat consumer) fails a boot that a real network would not fail.
+ */
+#define LAG_TICK_US 10000U
+static atomic_t lag_max_us;
+static struct co_timer lag_timers[N_LINES];
+static uint64_t lag_due[N_LINES]; /* written by each line's own thread */
+
+static void lag_tick(struct co_timer *timer, uint64_t now_us)
+{
+	struct co_line *line = timer->user_data;
+	int l = (int)(line - lines);
+	int64_t late = (int64_t)(co_line_now() - lag_due[l]);
+
+	/* Eight line threads update the maximum. */
+	for (atomic_val_t m = atomic_get(&lag_max_us); late > m; m = atomic_get(&lag_max_us)) {
+		if (atomic_cas(&lag_max_us, m, (atomic_val_t)late)) {
+			break;
+		}
+	}
+	lag_due[l] = co_line_now() + LAG_TICK_US;
+	co_timer_start(line, timer, lag_due[l]);
+}
+
 static void fail(const char *what)
 {
 	printf("mgr_bench: %s\n", what);
@@ -101,6 +139,70 @@ static void on_startup(struct co_node *node, enum co_mgr_startup result,
 {
 	startup_result = result;
 	k_sem_give(&startup_sem);
+}
+
+static void on_boot(struct co_node *node, uint8_t id, uint8_t status,
+		    const struct co_mgr_boot_error *err, void *user_data)
+{
+	if (status != CO_MGR_ST_OK && atomic_inc(&boot_errors) == 0 && err != NULL) {
+		first_err = *err;
+	}
+}
+
+static void on_ec(struct co_node *node, uint8_t id, enum co_mgr_ec_event event,
+		  enum co_nmt_state state, void *user_data)
+{
+	if (event == CO_MGR_EC_HB_LOST) {
+		atomic_inc(&hb_lost);
+	}
+}
+
+static void on_line_event(struct co_line *line, enum co_line_event event, int arg, void *user_data)
+{
+	if (event == CO_LINE_EV_RX_OVERRUN || event == CO_LINE_EV_TX_OVERFLOW) {
+		atomic_inc(&line_events);
+	}
+}
+
+/* Why a run failed: the counters, then each slave that did not end a full boot. */
+static void explain(unsigned int n)
+{
+	printf("mgr_bench: %ld heartbeat losses, %ld failed boot attempts, %ld line overruns, "
+	       "longest line lag %.1f ms\n",
+	       (long)atomic_get(&hb_lost), (long)atomic_get(&boot_errors),
+	       (long)atomic_get(&line_events), (double)atomic_get(&lag_max_us) / 1e3);
+	static enum co_nmt_state own[MAX_SLAVES];
+
+	/* Each slave's state under its own lock, before the manager's (no nested locks). */
+	for (unsigned int i = 0; i < n; i++) {
+		co_node_lock(&slaves[i].node);
+		own[i] = co_node_nmt_state(&slaves[i].node);
+		co_node_unlock(&slaves[i].node);
+	}
+	co_node_lock(&mgr);
+	if (atomic_get(&boot_errors) != 0) {
+		printf("mgr_bench: first failed attempt: node %u status %c in %s, %04Xh:%02Xh "
+		       "abort %08X\n",
+		       first_err.node_id, first_err.status, co_mgr_step_str(first_err.step),
+		       first_err.index, first_err.sub, first_err.abort_code);
+	}
+	for (unsigned int i = 0; i < n; i++) {
+		struct co_mgr_boot_info b;
+		uint8_t id = (uint8_t)(FIRST_SLAVE + i);
+
+		if (co_mgr_get_boot(&mgr, id, &b) != 0) {
+			continue;
+		}
+		if (b.status != CO_MGR_ST_OK || b.attempts != 1U || b.read_mask != 0x1FU ||
+		    b.booting || own[i] != CO_NMT_OPERATIONAL) {
+			printf("mgr_bench: node %u: status %02X (%s) attempts %u read %02X "
+			       "booting %d own state %02X, in the manager's view %02X\n",
+			       id, b.status,
+			       b.status == CO_MGR_ST_OK ? "ok" : co_mgr_step_str(b.error.step),
+			       b.attempts, b.read_mask, b.booting, own[i], b.nmt_state);
+		}
+	}
+	co_node_unlock(&mgr);
 }
 
 static int on_slave_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to,
@@ -144,6 +246,11 @@ static void setup(void)
 		}
 	}
 	co_mgr_set_startup_ind(&mgr, on_startup, NULL);
+	co_mgr_set_boot_ind(&mgr, on_boot, NULL);
+	co_mgr_set_ec_ind(&mgr, on_ec, NULL);
+	for (int l = 0; l < N_LINES; l++) {
+		co_line_set_event_cb(&lines[l], on_line_event, NULL);
+	}
 	for (int l = 0; l < N_LINES; l++) {
 		if (co_line_start(&lines[l], stacks[l], K_THREAD_STACK_SIZEOF(stacks[l]),
 				  CONFIG_CANOPEN_LINE_THREAD_PRIORITY) != 0) {
@@ -267,6 +374,10 @@ static void run(unsigned int n)
 	co_node_unlock(&mgr);
 	atomic_set(&op_count, 0);
 	atomic_set(&op_target, (atomic_val_t)n);
+	atomic_set(&hb_lost, 0);
+	atomic_set(&boot_errors, 0);
+	atomic_set(&line_events, 0);
+	atomic_set(&lag_max_us, 0);
 	k_sem_reset(&startup_sem);
 	k_sem_reset(&all_op_sem);
 	(void)can_virtual_bus_get_stats(0, &s0);
@@ -277,10 +388,12 @@ static void run(unsigned int n)
 	}
 	if (k_sem_take(&startup_sem, K_MSEC(RUN_WAIT_MS)) != 0 ||
 	    startup_result != CO_MGR_STARTUP_DONE) {
+		explain(n);
 		fail("the startup did not complete");
 	}
 	if (k_sem_take(&all_op_sem, K_MSEC(RUN_WAIT_MS)) != 0) {
 		printf("mgr_bench: %ld of %u slaves OPERATIONAL\n", (long)atomic_get(&op_count), n);
+		explain(n);
 		fail("not every slave became OPERATIONAL");
 	}
 	(void)can_virtual_bus_get_stats(0, &s1);
@@ -296,6 +409,7 @@ static void run(unsigned int n)
 			co_node_unlock(&mgr);
 			printf("mgr_bench: node %u status %02X attempts %u read %02X\n", id,
 			       b.status, b.attempts, b.read_mask);
+			explain(n);
 			fail("a boot was not a full one");
 		}
 		co_node_unlock(&mgr);
@@ -321,10 +435,12 @@ static void run(unsigned int n)
 	       "\"bus_bound_ms\": %.2f, \"floor_ms\": %.2f, \"ratio_to_floor\": %.2f, "
 	       "\"frames_needed\": %u, "
 	       "\"bits_needed\": %u, \"bus_frames\": %u, \"bus_busy_ms\": %.2f, "
-	       "\"cdcf_entries\": %u, \"hb_ms\": %u, \"bitrate\": %u}\n",
+	       "\"cdcf_entries\": %u, \"hb_ms\": %u, \"bitrate\": %u, "
+	       "\"line_lag_ms\": %.1f}\n",
 	       n, n, ms, bound_ms, floor_ms, ms / floor_ms, bound_frames, bound_bits,
 	       s1.frames - s0.frames, (double)(s1.busy_ns - s0.busy_ns) / 1e6,
-	       (unsigned int)co_od_le_get(net_slave_cdcf, 4), hb_ms, BITRATE);
+	       (unsigned int)co_od_le_get(net_slave_cdcf, 4), hb_ms, BITRATE,
+	       (double)atomic_get(&lag_max_us) / 1e3);
 }
 
 int main(void)
@@ -332,6 +448,11 @@ int main(void)
 	printf("mgr_bench: manager boots 1, 16 and %u slaves at %u bit/s (bit timing on)\n",
 	       MAX_SLAVES, BITRATE);
 	setup();
+	for (int l = 0; l < N_LINES; l++) {
+		co_timer_init(&lag_timers[l], lag_tick, NULL, &lines[l]);
+		lag_due[l] = co_line_now() + LAG_TICK_US;
+		co_timer_start(&lines[l], &lag_timers[l], lag_due[l]);
+	}
 	for (size_t r = 0; r < ARRAY_SIZE(runs); r++) {
 		run(runs[r]);
 	}
