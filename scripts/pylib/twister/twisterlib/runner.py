@@ -8,6 +8,7 @@ well). A progress line is printed as each instance finishes.
 """
 
 import os
+import signal
 import threading
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -65,6 +66,10 @@ class Runner:
         self.vcan_pending = 0
         self.vcan_thread: threading.Thread | None = None
         self.interrupted = False
+        # Set by SIGINT/SIGTERM during run(). The handler only sets it: a KeyboardInterrupt
+        # raised inside concurrent.futures.wait() can leave a future's lock taken, and the
+        # worker that then completes that future blocks forever (so did the run).
+        self.stop_requested = threading.Event()
 
     # --- progress -----------------------------------------------------------------------------
 
@@ -221,14 +226,13 @@ class Runner:
     def _run_pool(self, todo: list[TestInstance], work) -> None:
         with ThreadPoolExecutor(max_workers=max(1, self.opts.jobs)) as pool:
             futures = {pool.submit(work, inst) for inst in todo}
-            try:
-                while futures:
-                    _, futures = wait(futures, timeout=0.5, return_when=FIRST_COMPLETED)
-            except KeyboardInterrupt:
-                self.interrupt()
-                for f in futures:
-                    f.cancel()
-                raise
+            while futures:
+                if self.stop_requested.is_set():
+                    self.interrupt()
+                    for f in futures:
+                        f.cancel()
+                    raise KeyboardInterrupt
+                _, futures = wait(futures, timeout=0.5, return_when=FIRST_COMPLETED)
 
     def _run_vcan(self, todo: list[TestInstance]) -> None:
         lines = [inst.scenario.can_lines for inst in todo]
@@ -246,7 +250,22 @@ class Runner:
             log.warning("interrupted: stopping every child process")
         handler.REGISTRY.kill_all()
 
+    def _on_signal(self, signum, frame) -> None:
+        self.stop_requested.set()
+        # Kill the children from another thread: the main thread may be inside the registry's
+        # lock (a vcan retry batch runs on it), which the handler must not take again.
+        threading.Thread(target=self.interrupt, name="interrupt", daemon=True).start()
+
     def run(self) -> None:
+        """Run every instance; SIGINT and SIGTERM stop the run (children killed, rest skipped)."""
+        old = {sig: signal.signal(sig, self._on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            self._run()
+        finally:
+            for sig, h in old.items():
+                signal.signal(sig, h)
+
+    def _run(self) -> None:
         todo = [i for i in self.instances if i.status is None]
         self.total = len(todo)
         n_cpu = os.cpu_count() or 1
@@ -260,8 +279,12 @@ class Runner:
             self._run_pool(todo, self.process)
             if self.vcan_thread is not None:
                 while self.vcan_thread.is_alive():
+                    if self.stop_requested.is_set():
+                        raise KeyboardInterrupt
                     self.vcan_thread.join(timeout=0.5)
             for attempt in range(1, self.opts.retry_failed + 1):
+                if self.stop_requested.is_set():
+                    raise KeyboardInterrupt
                 if handler.REGISTRY.interrupted.is_set():
                     break
                 again = [i for i in todo if i.status in st.FAILING and i.reason != "build failure"]
