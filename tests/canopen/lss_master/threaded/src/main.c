@@ -98,7 +98,10 @@ ZTEST(co_lss_master_threaded, test_1_blocking_calls_from_an_application_thread)
 		memset(&res, 0, sizeof(res));
 		zassert_ok(co_lss_master_fastscan(&master, NULL, 0, WAIT, &res), "slave %d", n);
 		zassert_equal(res.address.part[3], 0x2000U - 1U + (uint32_t)n);
-		zassert_equal(res.frames, 133);
+		/* 133 without a restart; the simulated-time suite asserts the exact count, here a
+		 * late answer on a loaded host may cost a restart.
+		 */
+		zassert_true(res.frames >= 133, "%u frames", res.frames);
 		zassert_equal(co_lss_get_state(found), CO_LSS_STATE_CONFIGURATION);
 		zassert_ok(co_lss_master_inquire(&master, CO_LSS_CS_INQUIRE_SERIAL, WAIT, &res));
 		zassert_equal(res.value, 0x2000U - 1U + (uint32_t)n);
