@@ -11,6 +11,7 @@ bound is the protocol's plus a VM allowance (timing in the VM is noisy, so the t
 behaviour first and the time only against a generous bound).
 """
 
+import re
 import struct
 import time
 
@@ -41,17 +42,26 @@ CASES = [
 def test_good_stream_makes_the_srdo_valid(rig):
     """At the sample's own timing: pairs every 20 ms, SCT 50 ms, SRVT 10 ms."""
     assert rig.timing == SAMPLE_TIMING
-    rig.recover(settle=0.5)
-    # Both channels reached the dictionary: channel B is the complement of channel A.
-    # The counter moves every 20 ms: two SDO reads may straddle a pair, so read until a
-    # pair's two channels are caught together.
-    for _ in range(10):
-        a = rig.node.sdo[0x6000][2].raw
-        b = rig.node.sdo[0x6001][2].raw
-        if a ^ b == 0xFF:
+    for attempt in range(3):
+        since = rig.recover(settle=0.5)
+        # Both channels reached the dictionary: channel B is the complement of channel A.
+        # The counter moves every 20 ms: two SDO reads may straddle a pair, so read until a
+        # pair's two channels are caught together.
+        for _ in range(10):
+            a = rig.node.sdo[0x6000][2].raw
+            b = rig.node.sdo[0x6001][2].raw
+            if a ^ b == 0xFF:
+                break
+        assert a ^ b == 0xFF, (a, b)
+        assert rig.node.sdo[0x6000][1].raw == 0 and rig.node.sdo[0x6001][1].raw == 0xFF
+        if rig.node.sdo[0x2000].raw == 1:
             break
-    assert a ^ b == 0xFF, (a, b)
-    assert rig.node.sdo[0x6000][1].raw == 0 and rig.node.sdo[0x6001][1].raw == 0xFF
+        # The output may only be off because a fault was detected meanwhile (the VM's receive
+        # path, as in recover()); then try again. Off without a fault fails the test.
+        faults = [line.strip() for line in rig.controller.lines_since(since)
+                  if re.search(r"SAFE \((SCT|SRVT|NOT_INVERTED|SHORT)\)", line)]
+        assert faults, "the output is on"
+        rig.spurious.extend(faults)
     assert rig.node.sdo[0x2000].raw == 1, "the output is on"
     # The emergency stop on both channels turns the output off, without any SRDO fault.
     mark = rig.controller.mark()
