@@ -83,7 +83,7 @@ static void update_reg(struct co_node *node)
 
 /* --- Frames and the inhibit time ---------------------------------------------------------- */
 
-/* How long an EMCY that found the active line's TX queue full waits before it tries again. */
+/* How long an EMCY that found a TX queue of its lines full waits before it tries again. */
 #define EMCY_RETRY_US 10000U
 
 static uint64_t inhibit_us(const struct co_emcy *em)
@@ -112,10 +112,11 @@ static void publish(struct co_node *node, const struct can_frame *f, bool own)
 }
 
 /*
- * Send one EMCY frame, or return false when the active line's TX queue is full: the frame
- * would be dropped there, and an 8110h raised because that queue overflowed would be lost
- * with the frames it reports. The caller keeps it in the inhibit queue and tries again
- * EMCY_RETRY_US later.
+ * Send one EMCY frame, or return false when the TX queue of a line it goes on is full: the
+ * frame would be dropped there (and sent on the other line only), and an 8110h raised because
+ * that queue overflowed would be lost with the frames it reports. The caller keeps it in the
+ * inhibit queue and tries again EMCY_RETRY_US later. The check looks at the route the frame
+ * takes, so on two lines it waits until both have room.
  */
 static bool transmit(struct co_node *node, const uint8_t data[8], uint64_t now_us)
 {
@@ -124,7 +125,7 @@ static bool transmit(struct co_node *node, const uint8_t data[8], uint64_t now_u
 		.dlc = 8U,
 	};
 
-	if (co_node_tx_space(node, CO_ROUTE_ACTIVE) <= 0) {
+	if (co_node_tx_space(node, CO_ROUTE_PROCESS) <= 0) {
 		node->emcy.retry_us = now_us + EMCY_RETRY_US;
 		return false;
 	}

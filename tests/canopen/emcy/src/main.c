@@ -678,3 +678,71 @@ ZTEST(co_emcy, test_history_read_beyond_count_aborts_08000024h)
 	ztest_test_skip();
 #endif
 }
+
+/* --- Two lines (CiA 302-6): an EMCY goes on both and waits until both have room ---------- */
+
+static struct {
+	struct co_line line;
+	bool busy;
+	int n_emcy;
+} red;
+
+static int red_sink(struct co_line *line, const struct can_frame *frame, void *user_data)
+{
+	if (red.busy) {
+		return -EAGAIN;
+	}
+	red.n_emcy += frame->id == EMCY_ID;
+	return 0;
+}
+
+static void before_two_lines(void *f)
+{
+	memset(&t, 0, sizeof(t));
+	memset(&red, 0, sizeof(red));
+	co_sim_init();
+	co_line_init_sim(&red.line, "red", red_sink, NULL);
+	zassert_ok(co_node_init(&t.node, "dut", &sim.line, &emcy_test_od_def, &t.ram, NODE_ID));
+	zassert_ok(co_node_attach_line(&t.node, CO_LINE_REDUNDANT, &red.line));
+	zassert_ok(co_node_start(&t.node));
+	sim.n_sent = 0; /* boot-up */
+}
+
+/* Both lines' deadlines run on the default line; the redundant one only drains its queue. */
+static void run_two_lines_until(uint64_t at_us)
+{
+	co_sim_run_until(at_us);
+	co_line_process(&red.line, sim.now);
+}
+
+ZTEST_SUITE(co_emcy_two_lines, NULL, NULL, before_two_lines, NULL, NULL);
+
+ZTEST(co_emcy_two_lines, test_redundant_line_tx_queue_full_emcy_waits_then_goes_on_both)
+{
+	const struct can_frame filler = {.id = 0x7ff, .dlc = 0};
+	struct co_emcy_status st;
+	int idx[4];
+
+	/* The redundant line's controller pushes back until its TX queue is full. */
+	red.busy = true;
+	while (co_line_tx_space(&red.line) > 0) {
+		zassert_ok(co_line_send(&red.line, &filler));
+	}
+	zassert_true(co_line_tx_space(&sim.line) > 0, "the default line has room");
+
+	zassert_ok(co_emcy_raise(&t.node, 0x5000, 0, NULL), "kept, not an error");
+	zassert_equal(emcy_frames(idx, 4), 0, "not sent on the default line alone");
+	run_two_lines_until(sim.now + 25 * MS);
+	zassert_equal(emcy_frames(idx, 4), 0, "still waiting while the redundant queue is full");
+	co_emcy_get_status(&t.node, &st);
+	zassert_equal(st.overflows, 0U);
+
+	/* The redundant controller takes frames again: the EMCY goes on both at the next try. */
+	red.busy = false;
+	co_line_process(&red.line, sim.now);
+	zassert_equal(red.n_emcy, 0);
+	run_two_lines_until(sim.now + 10 * MS);
+	zassert_equal(emcy_frames(idx, 4), 1, "one EMCY on the default line");
+	assert_emcy(idx[0], EMCY_ID, 0x5000, 0x01, NULL);
+	zassert_equal(red.n_emcy, 1, "and its copy on the redundant line");
+}
