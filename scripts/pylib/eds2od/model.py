@@ -23,6 +23,8 @@ OBJCODES = {0x2: "DOMAIN", 0x5: "DEFTYPE", 0x6: "DEFSTRUCT", 0x7: "VAR", 0x8: "A
             0x9: "RECORD"}
 LIST_SECTIONS = ("mandatoryobjects", "optionalobjects", "manufacturerobjects")
 HEADER_SECTIONS = ("fileinfo", "deviceinfo", "dummyusage", "comments", "devicecomissioning")
+# The objects every device has (CiA 301 §7.5.2, CiA 306 [MandatoryObjects]).
+MANDATORY = {0x1000: "Device type", 0x1001: "Error register", 0x1018: "Identity object"}
 
 # Objects written by the device or acting as commands: never part of a stored group.
 NOT_STORED = {0x1001, 0x1002, 0x1003, 0x1010, 0x1011, 0x1023, 0x1024, 0x1025, 0x1026}
@@ -420,6 +422,7 @@ class Builder:
             # Other sections (tool-specific) are ignored like python-canopen does.
 
         self.check_lists(objs)
+        self.check_mandatory(objs)
         for idx in subsecs:
             if idx not in objs:
                 s = min(subsecs[idx].values(), key=lambda s: s.line)
@@ -568,6 +571,26 @@ class Builder:
             for idx, sec in objs.items():
                 if idx not in seen:
                     self.warn(sec.line, f"object [{sec.name}] is not listed in any object list")
+
+    def check_mandatory(self, objs):
+        """CiA 306 (and CiA 301) require 1000h, 1001h and 1018h of every device: a file
+        without them describes no device, with --strict or without. The error names the
+        entry of [MandatoryObjects] that lists the object, else that section, else the
+        first section of the file."""
+        lst = self.rd.sections.get("mandatoryobjects")
+        first = self.rd.order[0].line if self.rd.order else 1
+        listed = {}
+        if lst is not None:
+            for k in lst.order:
+                try:
+                    listed.setdefault(parse_int(k.value), k.line)
+                except ValueError:
+                    pass  # check_lists reports it
+        for idx, what in MANDATORY.items():
+            if idx not in objs:
+                line = listed.get(idx, lst.line if lst is not None else first)
+                self.err(line, f"mandatory object {idx:04X}h ({what}) is missing; CiA 306 "
+                               "requires 1000h, 1001h and 1018h in every EDS/DCF")
 
     def build_obj(self, idx, sec, subsecs, aux):
         name = sec.get("ParameterName")

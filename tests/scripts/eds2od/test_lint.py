@@ -113,6 +113,26 @@ def test_valid_file_passes(tmp_path):
     assert r.returncode == 0, r.stderr
 
 
+def test_missing_mandatory_object_named_at_its_list_entry(tmp_path):
+    text = eds(var(2000), [0x2000])
+    start = text.index("[1000]")
+    text = text[:start] + text[text.index("[1001]"):]
+    expect(tmp_path, text, "1=0x1000", "mandatory object 1000h (Device type) is missing")
+    p, r = lint(tmp_path, text)
+    assert "1001h" not in r.stderr.replace("1000h, 1001h and 1018h", ""), r.stderr
+
+
+def test_missing_mandatory_objects_refused_with_strict_or_without(tmp_path):
+    text = eds(var(2000), [0x2000])
+    text = text[:text.index("[1018]")] + text[text.index("[ManufacturerObjects]"):]
+    text = text.replace("SupportedObjects=3\n1=0x1000\n2=0x1001\n3=0x1018\n",
+                        "SupportedObjects=2\n1=0x1000\n2=0x1001\n")
+    expect(tmp_path, text, "[MandatoryObjects]", "mandatory object 1018h (Identity object)")
+    p, r = lint(tmp_path, text)
+    s = run_eds2od(p, extra=["--strict"])
+    assert s.returncode == 1 and "mandatory object 1018h" in s.stderr, s.stderr
+
+
 def test_unknown_data_type(tmp_path):
     expect(tmp_path, eds(var(2000, DataType="0x0017"), [0x2000]), "DataType=0x0017",
            "unknown data type")

@@ -15,14 +15,15 @@ BASE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 TP = os.path.join(HERE, "third_party")
 EDS2OD = os.path.join(BASE, "scripts", "eds2od")
 
-ACCEPTED = ["CANopenNode_DS301_profile.eds", "python-canopen_datatypes.eds",
-            "python-canopen_e35.eds", "lely-core_co-nmt-slave.dcf",
-            "lely-core_coapp-fiber-slave.dcf"]
+ACCEPTED = ["CANopenNode_DS301_profile.eds", "python-canopen_e35.eds",
+            "lely-core_co-nmt-slave.dcf", "lely-core_coapp-fiber-slave.dcf"]
 REFUSED = {
     "python-canopen_sample.eds": "2020h: unknown data type 0x40",
     "lely-core_co-pdo-receive.dcf": "1600h:1: maps 2000h:0 with 28 bits, but it is UNSIGNED32",
     "lely-core_co-pdo-transmit.dcf": "1A00h:1: maps 2000h:0 with 28 bits, but it is UNSIGNED32",
     "lely-core_co-sdev.dcf": "200Ch: ParameterValue '365 43200000' is not a valid TIME_OF_DAY",
+    # A data type test file, not a device: it lists 1018h only.
+    "python-canopen_datatypes.eds": "50: mandatory object 1000h (Device type) is missing",
 }
 
 
