@@ -558,6 +558,58 @@ ZTEST(co_mgr_fm, test_s9_56_higher_priority_candidate_forces)
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
 }
 
+/* 302 §5.3 / 302-2 §3.7 i: a lower-priority 071h during our own negotiation is forced too. */
+ZTEST(co_mgr_fm, test_lower_priority_071_during_negotiation_forces)
+{
+	int k;
+
+	candidate(0, 5, 0);
+	start_all();
+	/* Cold: 073h at 500, 000#8200 at 600; warm: 073h at 1100, 072h at 1200, W = 50 ms. */
+	run_ms(1220);
+	zassert_equal(fm(0).state, CO_MGR_FM_NEGOTIATE);
+	inject(0x071, 2, 0x02, 0x0A);
+	k = find(0x076, 0, 1200 * MS);
+	zassert_true(k >= 0, "076h to the lower-priority node");
+	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(at_ms(k), 1220);
+	zassert_equal(fm(0).state, CO_MGR_FM_FORCED);
+	zassert_equal(n_ev(0, CO_MGR_FM_EV_FORCE), 1);
+	/* No announcement of our own while the other resets the network. */
+	run_ms(100);
+	zassert_equal(count(0x071, 0, 0), 0);
+}
+
+/* 302 §5.3: 076h is for the active master only; every other state ignores it. */
+ZTEST(co_mgr_fm, test_076_ignored_unless_active_master)
+{
+	uint64_t since;
+
+	candidate(0, 5, 2);
+	start_all();
+	/* In the negotiation time delay: the timeline goes on unchanged (073h at 500). */
+	run_ms(200);
+	inject(0x076, 0, 0, 0);
+	run_ms(300);
+	zassert_equal(at_ms(find(0x073, 0, 0)), 500);
+	zassert_equal(find_nmt(0x82, 0, 0, 0), -1, "no reset for a 076h before the detection");
+	/* As a slave of node 0Ah (priority 0): no reset, no state change. */
+	inject(0x071, 2, 0x00, 0x0A);
+	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
+	since = t.now + 1; /* after its 073h */
+	for (int i = 0; i < 10; i++) {
+		inject(0x70A, 1, 0x05, 0);
+		if (i == 3) {
+			inject(0x076, 0, 0, 0);
+		}
+		run_ms(100);
+	}
+	zassert_equal(count(0x000, 0, since), 0, "a slave does not reset the network on 076h");
+	zassert_equal(count(0x071, 0, since) + count(0x072, 0, since) + count(0x073, 0, since), 0);
+	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
+	zassert_equal(n_ev(0, CO_MGR_FM_EV_RESIGN), 0);
+}
+
 ZTEST(co_mgr_fm, test_s9_57_second_072_restarts_the_slot_timer)
 {
 	candidate(0, 5, 1);
