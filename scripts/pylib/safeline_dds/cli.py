@@ -482,6 +482,7 @@ def main(argv=None):
         print(f"safeline-dds: {e} (the Python binding: pip install cyclonedds==11.0.1, "
               "scripts/setup installs it)", file=sys.stderr)
         return EXIT_FAILED
+    client = None
     try:
         client = BridgeClient(args.domain, args.dds_config, args.client, args.bridge)
         return COMMANDS[args.cmd](client, args)
@@ -497,6 +498,36 @@ def main(argv=None):
         return fail(args, str(e), EXIT_USAGE, "usage")
     except OSError as e:
         return fail(args, str(e), EXIT_FAILED, "error")
+    finally:
+        # The participant's goodbye reaches the bridge now, not at its lease's end.
+        if client is not None:
+            client.close()
+
+
+def run(argv=None):
+    """The command line's entry: main(), then out without the interpreter's finalization.
+
+    After SIGINT under load `watch` took seconds to exit, none of it in a wait: main()
+    returned within milliseconds and deleting the participant took 0.2-0.5 s, but Python's
+    finalization of the DDS binding's modules and objects took 1.5 s at a load of 19 on two
+    cores (more on a busier machine). Nothing is left for it to do once the participant is
+    gone, so the streams are flushed and the process ends with os._exit().
+    """
+    try:
+        code = main(argv)
+    except SystemExit as e:  # argparse's --help and usage errors, SIGTERM
+        code = e.code
+    if code is None:
+        code = EXIT_OK
+    elif not isinstance(code, int):
+        print(code, file=sys.stderr)
+        code = EXIT_FAILED
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a reader that went away, a closed stream
+            pass
+    os._exit(code)
 
 
 def fail(args, message, code, status, details=None):

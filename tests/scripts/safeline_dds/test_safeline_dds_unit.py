@@ -250,6 +250,7 @@ class FakeClient:
         self.domain_id = domain
         self.name = name
         self.requests = []
+        self.closed = False
         now = FakeClient.now
         self.bridge_state = T.BridgeState(bridge="manager", version="safeline-dds 1.0",
                                           domain_id=42, started_ns=now - 10 ** 10,
@@ -312,6 +313,9 @@ class FakeClient:
     def sdo_write(self, node, index, sub, data, **kw):
         self.requests.append(("write", node, index, sub, bytes(data)))
         return self.reply or T.SdoReply(client_id="c", status=T.STATUS_OK)
+
+    def close(self):
+        self.closed = True
 
     def nmt(self, node, command, **kw):
         self.requests.append(("nmt", node, command))
@@ -461,6 +465,35 @@ def test_watch_in_a_terminal_refreshes_in_place(fake, monkeypatch):
     assert text.startswith("\x1b[?25l\x1b[H\x1b[2J"), "hide the cursor, clear once"
     assert text.count("\x1b[H") == 4, "then home before each refresh, no scrolling"
     assert text.endswith("\x1b[?25h"), "the cursor comes back"
+
+
+class _Exited(Exception):
+    pass
+
+
+def run_entry(monkeypatch, *argv):
+    """cli.run() as scripts/safeline-dds calls it, its os._exit() caught: the code."""
+    def fake_exit(code):
+        raise _Exited(code)
+
+    monkeypatch.setattr(cli.os, "_exit", fake_exit)
+    with pytest.raises(_Exited) as e:
+        cli.run(list(argv))
+    return e.value.args[0]
+
+
+def test_the_entry_closes_the_client_and_skips_the_interpreters_finalization(fake, monkeypatch,
+                                                                              capsys):
+    assert run_entry(monkeypatch, "watch", "--count", "1", "--interval", "0") == cli.EXIT_OK
+    assert fake.made[0].closed, "the participant is deleted before the process ends"
+    assert "bridge manager" in capsys.readouterr().out
+    fake.reply = T.SdoReply(client_id="c", status=T.STATUS_ABORTED, abort_code=0x06020000,
+                            message="SDO abort 06020000h")
+    assert run_entry(monkeypatch, "read", "2", "1017", "0") == cli.EXIT_FAILED
+    assert fake.made[1].closed, "closed on a failure too"
+    # argparse's SystemExit (and SIGTERM's) ends in the same exit.
+    assert run_entry(monkeypatch, "nosuchcommand") == cli.EXIT_USAGE
+    assert run_entry(monkeypatch, "--help") == cli.EXIT_OK
 
 
 def test_no_bridge_and_config_errors_have_their_exit_codes(monkeypatch, capsys):
