@@ -529,6 +529,13 @@ ZTEST(co_pgm, test_control_values)
 	zassert_equal(sdo_dn(0x1F57, 1, &v, 4, CO_SDO_CLI_AUTO), CO_SDO_AB_READONLY);
 	zassert_equal(sdo_up(0x1F53, 1, &v), CO_SDO_AB_NO_OBJECT);
 	zassert_equal(sdo_up(0x1F51, 2, &v), CO_SDO_AB_NO_SUB);
+	/* One program (doc/pgm.md): sub-index 0 says 1 and program 2 does not exist. */
+	zassert_equal(read_u32(0x1F50, 0) & 0xff, 1U);
+	zassert_equal(read_u32(0x1F51, 0) & 0xff, 1U);
+	zassert_equal(sdo_dn(0x1F50, 2, img_new, sizeof(img_new), CO_SDO_CLI_BLOCK),
+		      CO_SDO_AB_NO_SUB);
+	zassert_equal(sdo_up(0x1F56, 2, &v), CO_SDO_AB_NO_SUB);
+	zassert_equal(sdo_up(0x1F57, 2, &v), CO_SDO_AB_NO_SUB);
 }
 
 /*
