@@ -174,6 +174,40 @@ void co_pgm_flash_ram_cut_after(struct co_pgm_flash_ram *r, uint32_t bytes);
 /** @brief Power back: accesses work again, no cut armed. */
 void co_pgm_flash_ram_power_on(struct co_pgm_flash_ram *r);
 
+/**
+ * @brief A flash kept in a host file, native board only (CONFIG_CANOPEN_PGM_FLASH_FILE).
+ *
+ * The same flash rules and power cut as struct co_pgm_flash_ram, but the slots live in a
+ * file (slot s at byte s x slot_size; bytes never written read as erased), so an image
+ * outlives the process: a device restarted as a new process boots what the file holds.
+ * After a cut every access fails with -EIO until the file is opened again (the next power-on).
+ */
+struct co_pgm_flash_file {
+	struct co_pgm_flash flash;
+	int fd; /**< host file descriptor, -1 when closed */
+	/** Bytes that may still be written before the cut; negative: no cut armed. */
+	int64_t budget;
+	bool off; /**< the power is cut */
+	uint32_t bytes_written;
+	uint32_t erases;
+};
+
+/**
+ * @brief Open (or create, erased) the file flash at @p path with slots of @p slot_size bytes.
+ *
+ * @retval 0 open
+ * @retval -EINVAL @p path NULL or empty, or @p slot_size below 48 or too large
+ * @retval -EFBIG the file is larger than two slots: a flash of another geometry
+ * @retval other the host's errno, negative (cannot open or create the file)
+ */
+int co_pgm_flash_file_open(struct co_pgm_flash_file *f, const char *path, uint32_t slot_size);
+
+/** @brief Close the file; the flash then fails every access with -EIO. */
+void co_pgm_flash_file_close(struct co_pgm_flash_file *f);
+
+/** @brief Cut the power after @p bytes more written bytes (as co_pgm_flash_ram_cut_after()). */
+void co_pgm_flash_file_cut_after(struct co_pgm_flash_file *f, uint32_t bytes);
+
 /* --- Slave side --------------------------------------------------------------------------------
  */
 
