@@ -510,14 +510,21 @@ static void hook_gen_bump(struct co_od *od)
 	}
 }
 
-/* Remove every hook registered from registration number @p first on (a failed batch). */
-static void hooks_drop_from(struct co_od *od, uint32_t first)
+/*
+ * Remove the hooks of a failed batch (registration number @p first_seq on) or those
+ * registered with @p user_data: one compaction loop for both, which also recomputes the
+ * widest span. Returns how many were removed.
+ */
+static int hooks_remove(struct co_od *od, bool batch, uint32_t first_seq, const void *user_data)
 {
 	uint16_t w = 0;
+	int removed = 0;
 
 	od->hook_span = 0;
 	for (uint16_t r = 0; r < od->n_hooks; r++) {
-		if (od->hook_seq[r] >= first) {
+		if (batch ? (od->hook_seq[r] >= first_seq)
+			  : (od->hooks[r].user_data == user_data)) {
+			removed++;
 			continue;
 		}
 		od->hooks[w] = od->hooks[r];
@@ -530,7 +537,10 @@ static void hooks_drop_from(struct co_od *od, uint32_t first)
 		w++;
 	}
 	od->n_hooks = w;
-	hook_gen_bump(od);
+	if (removed > 0) {
+		hook_gen_bump(od);
+	}
+	return removed;
 }
 
 int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n)
@@ -547,7 +557,7 @@ int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_
 
 		if (err != 0) {
 			/* All or nothing: a service never runs with half of its hooks. */
-			hooks_drop_from(od, first);
+			(void)hooks_remove(od, true, first, NULL);
 			return err;
 		}
 	}
@@ -586,30 +596,8 @@ int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 
 int co_od_hook_unregister(struct co_od *od, const void *user_data)
 {
-	uint16_t w = 0;
-	int removed = 0;
-
 	OD_ASSERT_LOCKED(od);
-	od->hook_span = 0;
-	for (uint16_t r = 0; r < od->n_hooks; r++) {
-		if (od->hooks[r].user_data == user_data) {
-			removed++;
-			continue;
-		}
-		od->hooks[w] = od->hooks[r];
-		od->hook_seq[w] = od->hook_seq[r];
-		uint16_t span = od->hooks[w].index_last - od->hooks[w].index_first;
-
-		if (span > od->hook_span) {
-			od->hook_span = span;
-		}
-		w++;
-	}
-	od->n_hooks = w;
-	if (removed > 0) {
-		hook_gen_bump(od);
-	}
-	return removed;
+	return hooks_remove(od, false, 0U, user_data);
 }
 
 /* First hook that may cover index: hooks start at most hook_span below it. */

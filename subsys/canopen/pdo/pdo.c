@@ -801,6 +801,26 @@ static int sync_event(struct co_node *node, const struct co_event *ev, void *use
 
 /* --- Hooks on 1400h-1BFFh ----------------------------------------------------------------- */
 
+/*
+ * A new COB-ID (sub-index 1) of an RPDO or TPDO whose COB-ID is @p cur: the CAN-ID changes only
+ * while the PDO is invalid, an 11-bit ID has no bits above 10 and is not a restricted one.
+ */
+static uint32_t cob_id_check(uint32_t cur, uint64_t v)
+{
+	if (cob_valid(cur) && cob_valid((uint32_t)v) &&
+	    ((v ^ cur) & ~(uint64_t)CO_PDO_COB_INVALID) != 0U) {
+		return AB_PDO_STATE;
+	}
+	if ((v & CO_PDO_COB_FRAME) == 0U && (v & 0x1FFFF800U) != 0U) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
+	    co_cob_id_restricted((uint32_t)v & CAN_ID_STD)) {
+		return CO_SDO_AB_INVALID_VALUE;
+	}
+	return 0U;
+}
+
 static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_rpdo *r = rpdo_of(user_data, req->info->index, IDX_RPDO_COMM);
@@ -811,18 +831,7 @@ static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 	}
 	switch (req->info->sub) {
 	case SUB_COB_ID:
-		if (cob_valid(r->cob_id) && cob_valid((uint32_t)v) &&
-		    ((v ^ r->cob_id) & ~(uint64_t)CO_PDO_COB_INVALID) != 0U) {
-			return AB_PDO_STATE;
-		}
-		if ((v & CO_PDO_COB_FRAME) == 0U && (v & 0x1FFFF800U) != 0U) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
-		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
-		    co_cob_id_restricted((uint32_t)v & CAN_ID_STD)) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
-		return 0U;
+		return cob_id_check(r->cob_id, v);
 	case SUB_TYPE:
 		/* 241..253 are reserved for RPDOs (CiA 301 §7.5.2.35). */
 		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_EVENT_MANUF) {
@@ -882,23 +891,15 @@ static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 	}
 	valid = cob_valid(t->cob_id);
 	switch (req->info->sub) {
-	case SUB_COB_ID:
-		if (valid && cob_valid((uint32_t)v) &&
-		    ((v ^ t->cob_id) & ~(uint64_t)CO_PDO_COB_INVALID) != 0U) {
-			return AB_PDO_STATE;
-		}
-		if ((v & CO_PDO_COB_FRAME) == 0U && (v & 0x1FFFF800U) != 0U) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
-		if (cob_valid((uint32_t)v) && (v & CO_PDO_COB_FRAME) == 0U &&
-		    co_cob_id_restricted((uint32_t)v & CAN_ID_STD)) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
+	case SUB_COB_ID: {
+		uint32_t ab = cob_id_check(t->cob_id, v);
+
 		/* An RTR-only TPDO needs remote requests. */
-		if ((v & CO_PDO_COB_NO_RTR) != 0U && is_rtr_type(t->type)) {
-			return CO_SDO_AB_INVALID_VALUE;
+		if (ab == 0U && (v & CO_PDO_COB_NO_RTR) != 0U && is_rtr_type(t->type)) {
+			ab = CO_SDO_AB_INVALID_VALUE;
 		}
-		return 0U;
+		return ab;
+	}
 	case SUB_TYPE:
 		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_RTR_SYNC) {
 			return CO_SDO_AB_INVALID_VALUE;
@@ -1054,6 +1055,47 @@ static bool od_has(struct co_node *node, uint16_t index)
 	return co_od_find(&node->od, index, 0, &info) == 0U;
 }
 
+/*
+ * The service's hooks, RPDO communication and mapping records first, then the TPDOs' (the
+ * order pdo_init() registers them in); index_last and user_data are filled in there.
+ */
+static const struct co_od_hook pdo_hooks[] = {
+	{
+		.index_first = IDX_RPDO_COMM,
+		.sub_first = 1,
+		.sub_last = 6,
+		.validate = rpdo_comm_validate,
+		.notify = rpdo_comm_notify,
+	},
+	{
+		.index_first = IDX_RPDO_MAP,
+		.sub_first = 0,
+		.sub_last = MAP_MAX,
+		.validate = map_validate,
+		.notify = map_notify,
+	},
+	{
+		.index_first = IDX_TPDO_COMM,
+		.sub_first = 1,
+		.sub_last = 6,
+		.validate = tpdo_comm_validate,
+		.notify = tpdo_comm_notify,
+	},
+	{
+		.index_first = IDX_TPDO_MAP,
+		.sub_first = 0,
+		.sub_last = MAP_MAX,
+		.validate = map_validate,
+		.notify = map_notify,
+	},
+};
+
+/* Instances of RPDOs or TPDOs the node has. */
+static uint16_t pdo_count(bool rx)
+{
+	return rx ? (uint16_t)CO_RPDOS : (uint16_t)CO_TPDOS;
+}
+
 static int pdo_init(struct co_node *node)
 {
 	struct co_pdo *pdo = &node->pdo;
@@ -1083,67 +1125,34 @@ static int pdo_init(struct co_node *node)
 		co_timer_init(&t->event_timer, tpdo_event_expired, &node->lock, t);
 	}
 	/* More PDOs in the dictionary than instances: refuse rather than ignore them. */
-	for (uint16_t i = CO_RPDOS; i < 512U; i++) {
-		if (od_has(node, IDX_RPDO_COMM + i) || od_has(node, IDX_RPDO_MAP + i)) {
-			LOG_ERR("%s: RPDO %u in the dictionary, CONFIG_CANOPEN_RPDOS=%d",
-				node->name, i, CO_RPDOS);
-			return -ENOSPC;
+	for (size_t h = 0; h < ARRAY_SIZE(pdo_hooks); h++) {
+		bool rx = h < 2U;
+
+		for (uint16_t i = pdo_count(rx); i < 512U; i++) {
+			if (od_has(node, pdo_hooks[h].index_first + i)) {
+				LOG_ERR("%s: %cPDO %u in the dictionary, CONFIG_CANOPEN_%cPDOS=%d",
+					node->name, rx ? 'R' : 'T', i, rx ? 'R' : 'T',
+					rx ? CO_RPDOS : CO_TPDOS);
+				return -ENOSPC;
+			}
 		}
 	}
-	for (uint16_t i = CO_TPDOS; i < 512U; i++) {
-		if (od_has(node, IDX_TPDO_COMM + i) || od_has(node, IDX_TPDO_MAP + i)) {
-			LOG_ERR("%s: TPDO %u in the dictionary, CONFIG_CANOPEN_TPDOS=%d",
-				node->name, i, CO_TPDOS);
-			return -ENOSPC;
+	/* One batch from the table above, ranges cut to the instances the node has. */
+	struct co_od_hook hooks[ARRAY_SIZE(pdo_hooks)];
+	size_t n = 0;
+
+	for (size_t h = 0; h < ARRAY_SIZE(pdo_hooks); h++) {
+		uint16_t count = pdo_count(h < 2U);
+
+		if (count > 0U) {
+			hooks[n] = pdo_hooks[h];
+			hooks[n].index_last = hooks[n].index_first + count - 1U;
+			hooks[n].user_data = node;
+			n++;
 		}
 	}
-	if (CO_RPDOS > 0) {
-		const struct co_od_hook hooks[] = {
-			{
-				.index_first = IDX_RPDO_COMM,
-				.index_last = IDX_RPDO_COMM + CO_RPDOS - 1,
-				.sub_first = 1,
-				.sub_last = 6,
-				.validate = rpdo_comm_validate,
-				.notify = rpdo_comm_notify,
-				.user_data = node,
-			},
-			{
-				.index_first = IDX_RPDO_MAP,
-				.index_last = IDX_RPDO_MAP + CO_RPDOS - 1,
-				.sub_first = 0,
-				.sub_last = MAP_MAX,
-				.validate = map_validate,
-				.notify = map_notify,
-				.user_data = node,
-			},
-		};
-
-		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
-	}
-	if (err == 0 && CO_TPDOS > 0) {
-		const struct co_od_hook hooks[] = {
-			{
-				.index_first = IDX_TPDO_COMM,
-				.index_last = IDX_TPDO_COMM + CO_TPDOS - 1,
-				.sub_first = 1,
-				.sub_last = 6,
-				.validate = tpdo_comm_validate,
-				.notify = tpdo_comm_notify,
-				.user_data = node,
-			},
-			{
-				.index_first = IDX_TPDO_MAP,
-				.index_last = IDX_TPDO_MAP + CO_TPDOS - 1,
-				.sub_first = 0,
-				.sub_last = MAP_MAX,
-				.validate = map_validate,
-				.notify = map_notify,
-				.user_data = node,
-			},
-		};
-
-		err = co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
+	if (n > 0U) {
+		err = co_od_hooks_register(&node->od, hooks, n);
 	}
 #if defined(CONFIG_CANOPEN_MPDO)
 	if (err == 0) {
