@@ -53,10 +53,18 @@ extern "C" {
 #else
 #define CO_OD_HOOKS_MAX 32
 #endif
+/* Object providers: on unless a Kconfig build turned CONFIG_CANOPEN_OD_PROVIDERS off. */
+#if defined(CONFIG_CANOPEN_OD_PROVIDERS) || !defined(CONFIG_CANOPEN_OD)
+#define CO_OD_PROVIDERS 1
+#else
+#define CO_OD_PROVIDERS 0
+#endif
 #ifdef CONFIG_CANOPEN_OD_PROVIDERS_MAX
 #define CO_OD_PROVIDERS_MAX CONFIG_CANOPEN_OD_PROVIDERS_MAX
-#else
+#elif CO_OD_PROVIDERS
 #define CO_OD_PROVIDERS_MAX 4
+#else
+#define CO_OD_PROVIDERS_MAX 0
 #endif
 #ifdef CONFIG_CANOPEN_OD_SCRATCH_SIZE
 #define CO_OD_SCRATCH_SIZE CONFIG_CANOPEN_OD_SCRATCH_SIZE
@@ -367,7 +375,9 @@ struct co_od {
 	const struct k_mutex *lock;
 	uint16_t n_hooks;
 	uint16_t hook_span; /**< largest index_last - index_first among hooks */
+#if CO_OD_PROVIDERS
 	uint8_t n_prov;
+#endif
 	co_od_restore_cb restore;
 	void *restore_user_data;
 	const struct co_od_xfer *scratch_owner;
@@ -381,7 +391,9 @@ struct co_od {
 	 * stale when it differs from the value they were made with.
 	 */
 	uint32_t hook_gen;
+#if CO_OD_PROVIDERS
 	const struct co_od_provider *prov[CO_OD_PROVIDERS_MAX]; /**< sorted by index_first */
+#endif
 	/** staging for chunked writes of values over 8 bytes (validate, then commit) */
 	uint8_t scratch[CO_OD_SCRATCH_SIZE] __attribute__((aligned(8)));
 };
@@ -498,6 +510,7 @@ int co_od_hook_unregister(struct co_od *od, const void *user_data);
  * @retval -EINVAL bad range or missing operations
  * @retval -EEXIST the range overlaps another provider
  * @retval -ENOSPC CONFIG_CANOPEN_OD_PROVIDERS_MAX providers already registered
+ * @retval -ENOTSUP CONFIG_CANOPEN_OD_PROVIDERS is off
  */
 int co_od_provider_register(struct co_od *od, const struct co_od_provider *p);
 /** @} */

@@ -495,6 +495,13 @@ void co_od_reset_app(struct co_od *od)
 	}
 }
 
+/*
+ * The provider of an object, NULL for a dictionary object. Without
+ * CONFIG_CANOPEN_OD_PROVIDERS no object has one, and the constant lets the compiler drop the
+ * accessors' provider branches.
+ */
+#define INFO_PROV(info) (CO_OD_PROVIDERS ? (info)->prov : NULL)
+
 /* ---------------------------------------------------------------------------------------- */
 /* Hooks and providers */
 
@@ -746,6 +753,7 @@ int co_od_provider_register(struct co_od *od, const struct co_od_provider *p)
 	    p->api->read == NULL || p->api->write == NULL || p->index_last < p->index_first) {
 		return -EINVAL;
 	}
+#if CO_OD_PROVIDERS
 	for (uint8_t i = 0; i < od->n_prov; i++) {
 		if (p->index_first <= od->prov[i]->index_last &&
 		    od->prov[i]->index_first <= p->index_last) {
@@ -757,15 +765,20 @@ int co_od_provider_register(struct co_od *od, const struct co_od_provider *p)
 	}
 	od->prov[od->n_prov++] = p;
 	return 0;
+#else
+	return -ENOTSUP;
+#endif
 }
 
 static const struct co_od_provider *provider_of(const struct co_od *od, uint16_t index)
 {
+#if CO_OD_PROVIDERS
 	for (uint8_t i = 0; i < od->n_prov; i++) {
 		if (index >= od->prov[i]->index_first && index <= od->prov[i]->index_last) {
 			return od->prov[i];
 		}
 	}
+#endif
 	return NULL;
 }
 
@@ -831,7 +844,7 @@ const void *co_od_value_ptr(const struct co_od *od, const struct co_od_info *inf
 
 uint32_t co_od_length(const struct co_od *od, const struct co_od_info *info)
 {
-	if (info->prov != NULL) {
+	if (INFO_PROV(info) != NULL) {
 		return info->prov->api->length != NULL ? info->prov->api->length(info->prov, info)
 						       : info->size;
 	}
@@ -940,7 +953,7 @@ uint32_t co_od_read_info(const struct co_od *od, const struct co_od_info *info, 
 	if (ab != 0U) {
 		return ab;
 	}
-	if (info->prov != NULL) {
+	if (INFO_PROV(info) != NULL) {
 		return info->prov->api->read(info->prov, info, offset, buf, cap, len);
 	}
 	*len = co_od_mem_read(info->desc, co_od_mem(od->def, od->ram, info->desc), offset, buf,
@@ -1067,7 +1080,7 @@ static uint32_t finish_write(struct co_od *od, const struct co_od_info *info, co
 		return ab;
 	}
 	if (ab == 0U) {
-		if (info->prov != NULL) {
+		if (INFO_PROV(info) != NULL) {
 			ab = info->prov->api->write(info->prov, info, 0, data, len, true);
 			if (ab != 0U) {
 				return ab;
@@ -1091,7 +1104,7 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 	if (ab != 0U) {
 		return ab;
 	}
-	if (info->prov != NULL && (info->flags & CO_OD_F_STREAM)) {
+	if (INFO_PROV(info) != NULL && (info->flags & CO_OD_F_STREAM)) {
 		struct co_od_req req = {.info = info, .writer = writer, .data = data, .len = len};
 
 		ab = run_validate(od, &req);
@@ -1191,7 +1204,7 @@ cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_c
 			 (h->notify != NULL ? CO_OD_COVER_NOTIFY : 0U) |
 			 (h->read_check != NULL ? CO_OD_COVER_READ_CHECK : 0U);
 	}
-	if (info->prov == NULL && (info->flags & CO_OD_F_ROM) == 0U &&
+	if (INFO_PROV(info) == NULL && (info->flags & CO_OD_F_ROM) == 0U &&
 	    co_dtype_size(info->dtype) != 0U && info->size == co_dtype_size(info->dtype) &&
 	    has_storage(info->desc)) {
 		flags |= CO_OD_COVER_DIRECT;
@@ -1473,7 +1486,7 @@ uint32_t co_od_write(struct co_od *od, uint16_t index, uint8_t sub, const void *
 
 static bool streaming(const struct co_od_xfer *x)
 {
-	return x->info.prov != NULL && (x->info.flags & CO_OD_F_STREAM);
+	return INFO_PROV(&x->info) != NULL && (x->info.flags & CO_OD_F_STREAM);
 }
 
 static void xfer_end(struct co_od *od, struct co_od_xfer *x)

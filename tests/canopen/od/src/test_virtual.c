@@ -133,6 +133,8 @@ static struct co_od_provider prov = {
 static struct co_od_provider stream_prov = {
 	.api = &v_api, .index_first = 0x2002, .index_last = 0x2002, .user_data = &store};
 
+#if defined(CONFIG_CANOPEN_OD_PROVIDERS)
+
 static void v_before(void *f)
 {
 	fx_before(f);
@@ -259,3 +261,35 @@ ZTEST(od_virtual, test_registration)
 }
 
 ZTEST_SUITE(od_virtual, NULL, NULL, v_before, NULL, NULL);
+
+#else /* !CONFIG_CANOPEN_OD_PROVIDERS */
+
+/* Built without providers: registering one says so, and their objects do not exist. */
+ZTEST(od_no_providers, test_registration_refused)
+{
+	struct co_od_provider bad = prov;
+
+	bad.api = NULL;
+	zassert_equal(co_od_provider_register(&fx.od, &bad), -EINVAL);
+	zassert_equal(co_od_provider_register(&fx.od, &prov), -ENOTSUP);
+	zassert_equal(co_od_provider_register(&fx.od, &stream_prov), -ENOTSUP);
+}
+
+ZTEST(od_no_providers, test_no_provider_objects)
+{
+	struct co_od_info info;
+	uint32_t v = 5;
+
+	(void)co_od_provider_register(&fx.od, &prov);
+	zassert_equal(co_od_find(&fx.od, 0x3000, 0, &info), CO_SDO_AB_NO_OBJECT);
+	zassert_equal(co_od_write(&fx.od, 0x3000, 0, &v, sizeof(v), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_OBJECT);
+	/* 2002h, a DOMAIN of the EDS without RAM, is a dictionary object without data. */
+	zassert_ok(co_od_find(&fx.od, 0x2002, 0, &info));
+	zassert_is_null(info.prov);
+	zassert_not_equal(co_od_write(&fx.od, 0x2002, 0, &v, 1, CO_OD_WRITER_SDO), 0U);
+}
+
+ZTEST_SUITE(od_no_providers, NULL, NULL, fx_before, NULL, NULL);
+
+#endif /* CONFIG_CANOPEN_OD_PROVIDERS */
