@@ -29,12 +29,9 @@
 #include <canopen/mgr.h>
 #include <canopen/node.h>
 #include <canopen/storage.h>
-#include <led_virtual.h>
-
-#include "cmdline.h"
 #include "commissioning_manager_od.h"
 #include "hello_node_od.h"
-#include "posix_native_task.h"
+#include "led_view.h"
 
 #define N_DEVICES  4
 #define MANAGER_ID 1U
@@ -60,54 +57,7 @@ static struct co_node manager;
 static struct commissioning_manager_od_ram mram;
 static K_THREAD_STACK_ARRAY_DEFINE(stacks, N_DEVICES + 1, CONFIG_CANOPEN_LINE_STACK_SIZE);
 static const struct device *leds;
-static bool live;
 static const char *status = "devices without node-ID; the manager boots";
-
-static void live_found(char *argv, int offset)
-{
-	live = true;
-}
-
-static void add_options(void)
-{
-	static struct args_struct_t opts[] = {
-		{
-			.is_switch = true,
-			.option = "live",
-			.type = 'b',
-			.call_when_found = live_found,
-			.descript = "draw the LEDs in place with coloured glyphs (a terminal), "
-				    "instead of one line per change",
-		},
-		ARG_TABLE_ENDMARKER,
-	};
-
-	native_add_command_line_opts(opts);
-}
-NATIVE_TASK(add_options, PRE_BOOT_1, 21);
-
-static const char *const pattern_names[] = {
-	[CO_LED_OFF] = "off",          [CO_LED_ON] = "on",
-	[CO_LED_FLICKER] = "flicker",  [CO_LED_BLINK] = "blink",
-	[CO_LED_FLASH1] = "1 flash",   [CO_LED_FLASH2] = "2 flashes",
-	[CO_LED_FLASH3] = "3 flashes", [CO_LED_FLASH4] = "4 flashes",
-};
-
-static bool led(uint32_t n)
-{
-	bool on = false;
-
-	(void)led_virtual_get(leds, n, &on);
-	return on;
-}
-
-static const char *glyph(bool on, bool red)
-{
-	if (!on) {
-		return "\033[2m\xe2\x97\x8b\033[0m"; /* dim ○ */
-	}
-	return red ? "\033[1;31m\xe2\x97\x8f\033[0m" : "\033[1;32m\xe2\x97\x8f\033[0m"; /* ● */
-}
 
 static uint8_t node_id(int i)
 {
@@ -122,25 +72,26 @@ static uint8_t node_id(int i)
 /* The live view: one line per device, redrawn in place. */
 static void draw(bool first)
 {
-	if (!first) {
-		printk("\033[%dA", N_DEVICES + 1);
-	}
-	printk("\r\033[K%s\n", status);
+	struct led_view_row rows[N_DEVICES];
+
 	for (int i = 0; i < N_DEVICES; i++) {
 		uint8_t id = node_id(i);
 		char ids[8];
 
 		(void)snprintf(ids, sizeof(ids), id == CO_NODE_ID_UNCONFIGURED ? "--" : "%u", id);
-		printk("\r\033[K  serial %04X  node %-3s RUN %s  ERR %s   LSS %-13s %-15s "
-		       "RUN %-9s ERR %s\n",
-		       SERIAL(i), ids, glyph(led((uint32_t)(2 * i)), false),
-		       glyph(led((uint32_t)(2 * i + 1)), true),
-		       co_lss_get_state(&devs[i].node) == CO_LSS_STATE_CONFIGURATION
-			       ? "configuration"
-			       : "waiting",
-		       co_nmt_state_str(devs[i].state), pattern_names[devs[i].run],
-		       pattern_names[devs[i].err]);
+		rows[i].green = (uint32_t)(2 * i);
+		rows[i].red = (uint32_t)(2 * i + 1);
+		(void)snprintf(rows[i].label, sizeof(rows[i].label), "serial %04X  node %-3s",
+			       SERIAL(i), ids);
+		(void)snprintf(rows[i].detail, sizeof(rows[i].detail),
+			       "LSS %-13s %-15s RUN %-9s ERR %s",
+			       co_lss_get_state(&devs[i].node) == CO_LSS_STATE_CONFIGURATION
+				       ? "configuration"
+				       : "waiting",
+			       co_nmt_state_str(devs[i].state), led_view_pattern_name(devs[i].run),
+			       led_view_pattern_name(devs[i].err));
 	}
+	led_view_draw(leds, first, status, rows, N_DEVICES);
 }
 
 static void note_changes(void)
@@ -159,10 +110,10 @@ static void note_changes(void)
 		devs[i].run = run;
 		devs[i].err = err;
 		devs[i].state = st;
-		if (!live) {
+		if (!led_view_live()) {
 			printk("commissioning: serial %04X node %u %s: RUN %s, ERR %s\n", SERIAL(i),
-			       node_id(i), co_nmt_state_str(st), pattern_names[run],
-			       pattern_names[err]);
+			       node_id(i), co_nmt_state_str(st), led_view_pattern_name(run),
+			       led_view_pattern_name(err));
 		}
 	}
 }
@@ -170,7 +121,7 @@ static void note_changes(void)
 static void say(const char *text)
 {
 	status = text;
-	if (!live) {
+	if (!led_view_live()) {
 		printk("commissioning: %s\n", text);
 	}
 }
@@ -343,7 +294,7 @@ int main(void)
 	t0 = k_uptime_get();
 	while (k_uptime_get() - t0 < RUN_MS) {
 		note_changes();
-		if (live) {
+		if (led_view_live()) {
 			draw(first);
 			first = false;
 		}
@@ -357,7 +308,7 @@ int main(void)
 	} else {
 		say("not every device became Operational");
 	}
-	if (live) {
+	if (led_view_live()) {
 		/* Let the person see the final state for a moment. */
 		for (int k = 0; k < 100; k++) {
 			note_changes();

@@ -37,9 +37,8 @@
 #include <canopen/node.h>
 #include <led_virtual.h>
 
-#include "cmdline.h"
 #include "hello_node_od.h"
-#include "posix_native_task.h"
+#include "led_view.h"
 
 #define N_DEVICES   4
 #define FIRST_ID    2
@@ -58,7 +57,6 @@ struct device_node {
 static struct device_node devs[N_DEVICES];
 static K_THREAD_STACK_ARRAY_DEFINE(stacks, N_DEVICES, CONFIG_CANOPEN_LINE_STACK_SIZE);
 static const struct device *leds;
-static bool live;
 
 /* Pattern changes, kept for the TRACE lines at the end. */
 static struct {
@@ -68,36 +66,6 @@ static struct {
 	uint8_t err;
 } patterns[256];
 static int n_patterns;
-
-static void live_found(char *argv, int offset)
-{
-	live = true;
-}
-
-static void add_options(void)
-{
-	static struct args_struct_t opts[] = {
-		{
-			.is_switch = true,
-			.option = "live",
-			.type = 'b',
-			.call_when_found = live_found,
-			.descript = "draw the LEDs in place with coloured glyphs (a terminal), "
-				    "instead of one line per change",
-		},
-		ARG_TABLE_ENDMARKER,
-	};
-
-	native_add_command_line_opts(opts);
-}
-NATIVE_TASK(add_options, PRE_BOOT_1, 21);
-
-static const char *const pattern_names[] = {
-	[CO_LED_OFF] = "off",          [CO_LED_ON] = "on",
-	[CO_LED_FLICKER] = "flicker",  [CO_LED_BLINK] = "blink",
-	[CO_LED_FLASH1] = "1 flash",   [CO_LED_FLASH2] = "2 flashes",
-	[CO_LED_FLASH3] = "3 flashes", [CO_LED_FLASH4] = "4 flashes",
-};
 
 static uint32_t green_led(int i)
 {
@@ -109,40 +77,25 @@ static uint32_t red_led(int i)
 	return (uint32_t)(2 * i + 1);
 }
 
-static bool led(uint32_t n)
-{
-	bool on = false;
-
-	(void)led_virtual_get(leds, n, &on);
-	return on;
-}
-
-static const char *glyph(bool on, bool red)
-{
-	if (!on) {
-		return "\033[2m\xe2\x97\x8b\033[0m"; /* dim ○ */
-	}
-	return red ? "\033[1;31m\xe2\x97\x8f\033[0m" : "\033[1;32m\xe2\x97\x8f\033[0m"; /* ● */
-}
-
 /* The live view: one line per device, redrawn in place. */
 static void draw(bool first, const char *story)
 {
-	if (!first) {
-		printk("\033[%dA", N_DEVICES + 1);
-	}
-	printk("\r\033[K%s\n", story);
+	struct led_view_row rows[N_DEVICES];
+
 	for (int i = 0; i < N_DEVICES; i++) {
 		enum co_nmt_state st;
 
 		co_node_lock(&devs[i].node);
 		st = co_nmt_get_state(&devs[i].node);
 		co_node_unlock(&devs[i].node);
-		printk("\r\033[K  node %d  RUN %s  ERR %s   %-15s RUN %-9s ERR %s\n", FIRST_ID + i,
-		       glyph(led(green_led(i)), false), glyph(led(red_led(i)), true),
-		       co_nmt_state_str(st), pattern_names[devs[i].run],
-		       pattern_names[devs[i].err]);
+		rows[i].green = green_led(i);
+		rows[i].red = red_led(i);
+		(void)snprintf(rows[i].label, sizeof(rows[i].label), "node %d ", FIRST_ID + i);
+		(void)snprintf(rows[i].detail, sizeof(rows[i].detail), "%-15s RUN %-9s ERR %s",
+			       co_nmt_state_str(st), led_view_pattern_name(devs[i].run),
+			       led_view_pattern_name(devs[i].err));
 	}
+	led_view_draw(leds, first, story, rows, N_DEVICES);
 }
 
 static void note_patterns(void)
@@ -161,9 +114,9 @@ static void note_patterns(void)
 				k_ticks_to_us_floor64((uint64_t)k_uptime_ticks()), FIRST_ID + i,
 				run, err};
 		}
-		if (!live) {
+		if (!led_view_live()) {
 			printk("indicators: node %d RUN %s, ERR %s\n", FIRST_ID + i,
-			       pattern_names[run], pattern_names[err]);
+			       led_view_pattern_name(run), led_view_pattern_name(err));
 		}
 	}
 }
@@ -232,8 +185,8 @@ static void print_trace(void)
 
 	for (int i = 0; i < n_patterns; i++) {
 		printk("TRACE pattern %llu %u %s %s\n", (unsigned long long)patterns[i].t_us,
-		       patterns[i].id, pattern_names[patterns[i].run],
-		       pattern_names[patterns[i].err]);
+		       patterns[i].id, led_view_pattern_name(patterns[i].run),
+		       led_view_pattern_name(patterns[i].err));
 	}
 	while ((n = led_virtual_trace(leds, from, c, ARRAY_SIZE(c), &from)) > 0) {
 		for (size_t k = 0; k < n; k++) {
@@ -334,7 +287,7 @@ int main(void)
 
 		while (next < ARRAY_SIZE(story) && now >= story[next].t_ms) {
 			text = story[next].text;
-			if (!live) {
+			if (!led_view_live()) {
 				printk("indicators: %u.%01u s %s\n", story[next].t_ms / 1000U,
 				       story[next].t_ms % 1000U / 100U, text);
 			}
@@ -344,7 +297,7 @@ int main(void)
 			next++;
 		}
 		note_patterns();
-		if (live) {
+		if (led_view_live()) {
 			draw(first, text);
 			first = false;
 		}
