@@ -191,7 +191,7 @@ static inline uint32_t co_lss_bit_timing_bps(uint8_t index, bool legacy_100k)
 /** @brief Start an LSS frame: identifier @p id, 8 zero bytes, command specifier @p cs. */
 static inline void co_lss_frame_init(struct can_frame *f, uint32_t id, uint8_t cs)
 {
-	memset(f, 0, sizeof(*f));
+	(void)memset(f, 0, sizeof(*f));
 	f->id = id;
 	f->dlc = CO_LSS_DLC;
 	f->data[0] = cs;

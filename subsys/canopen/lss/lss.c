@@ -215,6 +215,8 @@ static void switch_timer(struct co_timer *timer, uint64_t now_us)
 			LOG_INF("%s: LSS: %s at %u bit/s", node->name,
 				l->switch_failed ? "resumed" : "switched", l->active_bitrate);
 		}
+	} else {
+		/* SWITCH_IDLE: no switch is running. */
 	}
 }
 
@@ -519,6 +521,8 @@ static void lss_rx(struct co_rx *rx, const struct can_frame *f, uint64_t now_us)
 		fastscan(node, f);
 	} else if (l->state == CO_LSS_STATE_CONFIGURATION) {
 		configure(node, f, now_us);
+	} else {
+		/* Configuration commands outside the configuration state are ignored (CiA 305). */
 	}
 }
 

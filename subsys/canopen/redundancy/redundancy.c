@@ -286,6 +286,8 @@ static void hb_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	} else if (line == CO_LINE_DEFAULT && !was_ok && default_line_ok(r)) {
 		publish(node, CO_RDN_EV_DEFAULT_LINE_OK, CO_LINE_DEFAULT, 0U, now_us);
 		step(node, IN_DEFAULT_OK, now_us);
+	} else {
+		/* Without ECSS, the default line did not just become good: nothing to report. */
 	}
 	arm(node);
 }
@@ -377,6 +379,8 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 		} else if (two_lines(node) && ev->line.event == CO_LINE_EV_TX_ERROR &&
 			   link_error(ev->line.arg)) {
 			link_state(node, ev->line.idx, true);
+		} else {
+			/* Other line events do not change a line's state. */
 		}
 		return 0;
 	}
@@ -392,6 +396,8 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 		r->tpdo_errors = (uint16_t)MIN(r->tpdo_errors + TPDO_FAIL_STEP, r->tpdo_max);
 	} else if (r->tpdo_errors > 0U) {
 		r->tpdo_errors--;
+	} else {
+		/* No error counted and none to take back. */
 	}
 	if (!r->tpdo_failed && r->tpdo_errors >= r->tpdo_max) {
 		r->tpdo_failed = true;
@@ -402,6 +408,8 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 		r->tpdo_failed = false;
 		co_hb_hold(node, false);
 		publish(node, CO_RDN_EV_TPDO_OK, co_node_active_line(node), 0U, now);
+	} else {
+		/* TPDO 1 state unchanged. */
 	}
 	return 0;
 }
@@ -429,7 +437,7 @@ static void consumer_notify(struct co_od *od, const struct co_od_req *req, void 
 		return;
 	}
 	supervised_read(node);
-	memset(r->hb, 0, sizeof(r->hb));
+	(void)memset(r->hb, 0, sizeof(r->hb));
 	if (ECSS && r->state != CO_RDN_NO_MASTER) {
 		r->toggle_at = toggle_deadline(node, co_node_time(node));
 	}
@@ -456,7 +464,7 @@ static int rdn_init(struct co_node *node)
 		},
 	};
 
-	memset(r, 0, sizeof(*r));
+	(void)memset(r, 0, sizeof(*r));
 	co_rx_init(&r->fwd, 0U, fwd_rx, &node->lock, node);
 	r->fwd.mask = 0U;
 	co_rx_init(&r->fwd_ext, 0U, fwd_rx, &node->lock, node);
@@ -501,7 +509,7 @@ static void rdn_reset_comm(struct co_node *node)
 	co_rx_unregister(&r->fwd);
 	co_rx_unregister(&r->fwd_ext);
 	co_rx_unregister(&r->hb_rx);
-	memset(r->hb, 0, sizeof(r->hb));
+	(void)memset(r->hb, 0, sizeof(r->hb));
 	r->tpdo_max = (uint8_t)co_od_uint(&node->od, CO_RDN_IDX, CO_RDN_SUB_TPDO_MAX, 0U);
 	r->tpdo_errors = 0U;
 	if (r->tpdo_failed) {

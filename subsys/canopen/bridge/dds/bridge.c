@@ -153,13 +153,13 @@ static void atomic_max(atomic_t *a, atomic_val_t v)
 static void post(const struct br_event *e)
 {
 	if (k_msgq_put(&br_queue, e, K_NO_WAIT) != 0) {
-		atomic_inc(&br.events_lost);
+		(void)atomic_inc(&br.events_lost);
 		if (e->slot < CONFIG_CANOPEN_BRIDGE_DDS_LINES) {
-			atomic_inc(&br.lines[e->slot].events_lost);
+			(void)atomic_inc(&br.lines[e->slot].events_lost);
 		}
 		return;
 	}
-	atomic_inc(&br.events);
+	(void)atomic_inc(&br.events);
 	atomic_max(&br.queue_max, (atomic_val_t)k_msgq_num_used_get(&br_queue));
 }
 
@@ -227,7 +227,7 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 		e.emcy.cob_id = ev->emcy.cob_id;
 		e.emcy.reg = ev->emcy.reg;
 		e.emcy.own = ev->emcy.own;
-		memcpy(e.emcy.msef, ev->emcy.msef, sizeof(e.emcy.msef));
+		(void)memcpy(e.emcy.msef, ev->emcy.msef, sizeof(e.emcy.msef));
 		break;
 	case CO_EV_ERROR:
 		/*
@@ -346,22 +346,22 @@ bool br_node_known(int slot, uint8_t node_id)
 	if (slot < 0 || node_id == 0U || node_id > 127U) {
 		return false;
 	}
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	known = br.lines[slot].rec_of[node_id].known ||
 		atomic_get(&br.lines[slot].hb_us[node_id]) != 0 ||
 		br_bnode_at(slot, node_id) != NULL ||
 		br_conf_eds(&br.conf, br.lines[slot].line_no, node_id) != NULL;
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 	return known;
 }
 
 void br_node_status(int slot, uint8_t node_id, uint8_t *nmt, uint8_t *hb)
 {
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	*nmt = br.lines[slot].rec_of[node_id].known ? br.lines[slot].rec_of[node_id].nmt
 						    : BR_NMT_UNKNOWN;
 	*hb = br.lines[slot].rec_of[node_id].hb;
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 }
 
 static struct br_node_rec *rec(int slot, uint8_t node_id)
@@ -420,7 +420,7 @@ int br_write(dds_entity_t wr, const void *sample)
 		LOG_WRN("dds_write: %s", dds_strretcode(rc));
 		return -EIO;
 	}
-	atomic_inc(&br.samples);
+	(void)atomic_inc(&br.samples);
 	return 0;
 }
 
@@ -558,7 +558,7 @@ void br_publish_value(struct br_object *o, uint32_t abort_code, const uint8_t *d
 	o->published = true;
 	o->abort_code = abort_code;
 	o->size = (uint32_t)len;
-	memmove(o->data, data, keep);
+	(void)memmove(o->data, data, keep);
 	o->changes++;
 	eds = br_conf_eds(&br.conf, o->line_no, o->node_id);
 	ent = br_eds_find(eds, o->index, o->sub);
@@ -573,6 +573,8 @@ void br_publish_value(struct br_object *o, uint32_t abort_code, const uint8_t *d
 			s.data_type = info.dtype;
 		}
 		co_node_unlock(node);
+	} else {
+		/* An object neither the EDS nor the node knows keeps data type 0 (unknown). */
 	}
 	s.data._length = (uint32_t)keep;
 	s.data._maximum = (uint32_t)keep;
@@ -639,7 +641,7 @@ static void boot_info(struct br_bnode *b, int slot, uint8_t id, uint64_t t_ns, b
 	if (co_mgr_get_boot(b->node, id, &info) != 0) {
 		return;
 	}
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	n = rec(slot, id);
 	if (!only_known || n->known || info.assigned) {
 		n = touch(slot, id, t_ns);
@@ -650,13 +652,13 @@ static void boot_info(struct br_bnode *b, int slot, uint8_t id, uint64_t t_ns, b
 		if (info.read_mask != 0U) {
 			n->id_mask = info.read_mask & 0x1FU;
 			n->ident[0] = info.device_type;
-			memcpy(&n->ident[1], info.identity, sizeof(info.identity));
+			(void)memcpy(&n->ident[1], info.identity, sizeof(info.identity));
 		}
 		if (n->nmt == BR_NMT_UNKNOWN && !n->local && info.nmt_state != 0U) {
 			n->nmt = info.nmt_state;
 		}
 	}
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 #endif
 }
 
@@ -671,9 +673,9 @@ static void snapshot(struct br_bnode *b, int slot, uint64_t t_ns)
 
 	/* Its identity: 1000h and 1018h:01..04 of its own dictionary. */
 	co_node_lock(b->node);
-	for (int i = 0; i < 5; i++) {
-		uint16_t index = i == 0 ? 0x1000U : 0x1018U;
-		uint8_t sub = i == 0 ? 0U : (uint8_t)i;
+	for (unsigned int i = 0U; i < 5U; i++) {
+		uint16_t index = i == 0U ? 0x1000U : 0x1018U;
+		uint8_t sub = i == 0U ? 0U : (uint8_t)i;
 		struct co_od_info info;
 
 		if (co_od_find(co_node_od(b->node), index, sub, &info) == 0U) {
@@ -683,16 +685,16 @@ static void snapshot(struct br_bnode *b, int slot, uint64_t t_ns)
 	}
 	co_node_unlock(b->node);
 
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	n = touch(slot, b->node_id, t_ns);
 	n->local = true;
 	n->nmt = state;
 	n->id_mask = mask;
-	memcpy(n->ident, ident, sizeof(ident));
+	(void)memcpy(n->ident, ident, sizeof(ident));
 	if (b->name[0] != '\0') {
 		(void)snprintf(n->name, sizeof(n->name), "%s", b->name);
 	}
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 
 	for (uint8_t id = 1; id <= 127U; id++) {
 		int err;
@@ -702,15 +704,17 @@ static void snapshot(struct br_bnode *b, int slot, uint64_t t_ns)
 		}
 		err = co_hb_get_remote_state(b->node, id, &remote);
 		if (err != -ENOENT) {
-			k_mutex_lock(&br.lock, K_FOREVER);
+			(void)k_mutex_lock(&br.lock, K_FOREVER);
 			n = touch(slot, id, t_ns);
 			if (err == 0) {
 				n->hb = BR_HB_ACTIVE;
 				n->nmt = (uint8_t)remote;
 			} else if (n->hb == BR_HB_NONE) {
 				n->hb = BR_HB_WAITING;
+			} else {
+				/* Still waiting or already seen: nothing new to record. */
 			}
-			k_mutex_unlock(&br.lock);
+			(void)k_mutex_unlock(&br.lock);
 		}
 		boot_info(b, slot, id, t_ns, true);
 	}
@@ -754,7 +758,7 @@ static void write_emcy(int slot, const struct br_event *e, struct br_node_rec *n
 		.time_ns = br_wall_ns(e->time_us),
 	};
 
-	memcpy(s.msef, e->emcy.msef, sizeof(s.msef));
+	(void)memcpy(s.msef, e->emcy.msef, sizeof(s.msef));
 	(void)br_write(br.wr_emcy, &s);
 }
 
@@ -822,9 +826,9 @@ static void apply(const struct br_event *e)
 		n = touch(slot, e->node_id, t);
 		n->boot_status = e->boot.status;
 		n->boot_ns = t;
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		boot_info(&br.bnodes[e->src], slot, e->node_id, t, false);
-		k_mutex_lock(&br.lock, K_FOREVER);
+		(void)k_mutex_lock(&br.lock, K_FOREVER);
 		break;
 	case BR_EV_SRDO:
 		n = touch(slot, e->node_id, t);
@@ -840,9 +844,9 @@ static void apply(const struct br_event *e)
 		publish_srdo(s);
 		break;
 	case BR_EV_SNAPSHOT:
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		snapshot(&br.bnodes[e->src], slot, t);
-		k_mutex_lock(&br.lock, K_FOREVER);
+		(void)k_mutex_lock(&br.lock, K_FOREVER);
 		break;
 	default:
 		break;
@@ -929,7 +933,7 @@ static void bridge_main(void *p1, void *p2, void *p3)
 	uint32_t lost_logged = 0;
 	struct br_event e;
 
-	while (atomic_get(&br.running)) {
+	while (atomic_get(&br.running) != 0) {
 		uint64_t now = co_line_now();
 		uint64_t next_poll;
 		uint64_t wake;
@@ -940,7 +944,7 @@ static void bridge_main(void *p1, void *p2, void *p3)
 		got = k_msgq_get(&br_queue, &e,
 				 co_time_before_eq(wake, now) ? K_NO_WAIT
 							      : K_USEC((int64_t)(wake - now)));
-		k_mutex_lock(&br.lock, K_FOREVER);
+		(void)k_mutex_lock(&br.lock, K_FOREVER);
 		/* Everything queued now, then the samples of what changed. */
 		for (int i = 0; got == 0 && i < 4096; i++) {
 			apply(&e);
@@ -959,14 +963,14 @@ static void bridge_main(void *p1, void *p2, void *p3)
 			next_refresh = now + period_us;
 		}
 		publish_dirty();
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		if ((uint32_t)atomic_get(&br.events_lost) != lost_logged) {
 			lost_logged = (uint32_t)atomic_get(&br.events_lost);
 			LOG_WRN("%u events lost so far: the queue (%d) was full", lost_logged,
 				CONFIG_CANOPEN_BRIDGE_DDS_QUEUE_SIZE);
 		}
 	}
-	atomic_set(&br.bridge_done, 1);
+	(void)atomic_set(&br.bridge_done, 1);
 }
 
 /* --- Set-up ---------------------------------------------------------------------------------- */
@@ -1119,8 +1123,8 @@ int co_bridge_dds_init(const struct co_bridge_dds_config *cfg)
 	/* br is zero from the start and initialised once (started): no memset, which a thread
 	 * stopping the bridge at exit could see half done.
 	 */
-	k_mutex_init(&br.lock);
-	strcpy(br.name, name);
+	(void)k_mutex_init(&br.lock);
+	(void)strcpy(br.name, name);
 	br.domain_id = cfg->domain_id == CO_BRIDGE_DDS_DOMAIN_DEFAULT
 			       ? CONFIG_CANOPEN_BRIDGE_DDS_DOMAIN
 			       : cfg->domain_id;
@@ -1138,19 +1142,19 @@ int co_bridge_dds_init(const struct co_bridge_dds_config *cfg)
 	}
 	if (err != 0) {
 		br_conf_free(&br.conf);
-		memset(&br.conf, 0, sizeof(br.conf));
-		atomic_set(&started, 0);
+		(void)memset(&br.conf, 0, sizeof(br.conf));
+		(void)atomic_set(&started, 0);
 		return err;
 	}
-	atomic_set(&br.running, 1);
+	(void)atomic_set(&br.running, 1);
 	(void)k_thread_create(&bridge_thread, bridge_stack, K_THREAD_STACK_SIZEOF(bridge_stack),
 			      bridge_main, NULL, NULL, NULL,
 			      CONFIG_CANOPEN_BRIDGE_DDS_THREAD_PRIORITY, 0, K_NO_WAIT);
-	k_thread_name_set(&bridge_thread, "dds_bridge");
+	(void)k_thread_name_set(&bridge_thread, "dds_bridge");
 	(void)k_thread_create(&request_thread, request_stack, K_THREAD_STACK_SIZEOF(request_stack),
 			      br_request_thread, NULL, NULL, NULL,
 			      CONFIG_CANOPEN_BRIDGE_DDS_THREAD_PRIORITY, 0, K_NO_WAIT);
-	k_thread_name_set(&request_thread, "dds_requests");
+	(void)k_thread_name_set(&request_thread, "dds_requests");
 	LOG_INF("bridge %s on DDS domain %u (%s), %s", br.name, br.domain_id,
 		cfg->dds_config != NULL ? cfg->dds_config : "loopback configuration",
 		br.conf.allow ? "allow-list" : "read-only");
@@ -1169,20 +1173,20 @@ int co_bridge_dds_add_line(struct co_line *line, uint8_t line_no, const char *na
 	if (!atomic_get(&br.running)) {
 		return -ESRCH;
 	}
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	n = (int)atomic_get(&br.n_lines);
 	for (int i = 0; i < n; i++) {
 		if (br.lines[i].line == line || br.lines[i].line_no == line_no) {
-			k_mutex_unlock(&br.lock);
+			(void)k_mutex_unlock(&br.lock);
 			return -EALREADY;
 		}
 	}
 	if (n == CONFIG_CANOPEN_BRIDGE_DDS_LINES) {
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		return -ENOSPC;
 	}
 	l = &br.lines[n];
-	memset(l, 0, sizeof(*l));
+	(void)memset(l, 0, sizeof(*l));
 	l->line = line;
 	l->line_no = line_no;
 	l->can_state = 0xFFU;
@@ -1190,7 +1194,7 @@ int co_bridge_dds_add_line(struct co_line *line, uint8_t line_no, const char *na
 	read_can_state(l);
 	co_line_get_stats(line, &l->stats);
 	if (name != NULL) {
-		strcpy(l->name, name);
+		(void)strcpy(l->name, name);
 	}
 	/* 701h..77Fh: heartbeats, boot-ups, guarding replies. */
 	l->hb_rx = (struct co_rx){
@@ -1202,11 +1206,11 @@ int co_bridge_dds_add_line(struct co_line *line, uint8_t line_no, const char *na
 	if (err == 0) {
 		struct br_event wake = {.kind = BR_EV_WAKE, .slot = 0xFFU};
 
-		atomic_set(&br.n_lines, n + 1);
-		atomic_set(&br.bridge_dirty, 1);
+		(void)atomic_set(&br.n_lines, n + 1);
+		(void)atomic_set(&br.bridge_dirty, 1);
 		(void)k_msgq_put(&br_queue, &wake, K_NO_WAIT);
 	}
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 	return err;
 }
 
@@ -1223,26 +1227,26 @@ int co_bridge_dds_add_node(struct co_node *node, const struct co_bridge_dds_node
 	if (!atomic_get(&br.running)) {
 		return -ESRCH;
 	}
-	k_mutex_lock(&br.lock, K_FOREVER);
+	(void)k_mutex_lock(&br.lock, K_FOREVER);
 	n = (int)atomic_get(&br.n_bnodes);
 	for (int i = 0; i < n; i++) {
 		if (br.bnodes[i].node == node) {
-			k_mutex_unlock(&br.lock);
+			(void)k_mutex_unlock(&br.lock);
 			return -EALREADY;
 		}
 	}
 	if (n == CONFIG_CANOPEN_BRIDGE_DDS_NODES) {
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		return -ENOSPC;
 	}
 	b = &br.bnodes[n];
-	memset(b, 0, sizeof(*b));
+	(void)memset(b, 0, sizeof(*b));
 	b->node = node;
 	b->idx = (uint8_t)n;
 	b->node_id = co_node_id(node);
 	b->sdo_client = cfg != NULL ? cfg->sdo_client : CO_BRIDGE_DDS_NO_SDO_CLIENT;
 	if (cfg != NULL && cfg->name != NULL) {
-		strcpy(b->name, cfg->name);
+		(void)strcpy(b->name, cfg->name);
 	}
 	for (int i = 0; i < (int)CO_NODE_LINES; i++) {
 		struct co_line *line = co_node_get_line(node, (enum co_node_line_id)i);
@@ -1256,7 +1260,7 @@ int co_bridge_dds_add_node(struct co_node *node, const struct co_bridge_dds_node
 		b->slot[i] = slot < 0 ? BR_NO_LINE : (uint8_t)slot;
 	}
 	if (b->slot[CO_LINE_DEFAULT] == BR_NO_LINE || b->node_id == 0U || b->node_id > 127U) {
-		k_mutex_unlock(&br.lock);
+		(void)k_mutex_unlock(&br.lock);
 		return b->slot[CO_LINE_DEFAULT] == BR_NO_LINE ? -ENOENT : -EINVAL;
 	}
 	co_listener_init(&b->listener, "dds bridge", EVENT_MASK, on_event, b);
@@ -1264,14 +1268,14 @@ int co_bridge_dds_add_node(struct co_node *node, const struct co_bridge_dds_node
 	if (err == 0) {
 		br.lines[b->slot[CO_LINE_DEFAULT]].nodes++;
 		br.lines[b->slot[CO_LINE_DEFAULT]].dirty = true;
-		atomic_set(&br.n_bnodes, n + 1);
-		atomic_set(&br.bridge_dirty, 1);
+		(void)atomic_set(&br.n_bnodes, n + 1);
+		(void)atomic_set(&br.bridge_dirty, 1);
 		e.slot = b->slot[CO_LINE_DEFAULT];
 		e.node_id = b->node_id;
 		e.src = b->idx;
 		e.time_us = co_line_now();
 	}
-	k_mutex_unlock(&br.lock);
+	(void)k_mutex_unlock(&br.lock);
 	if (err == 0) {
 		/* The snapshot must not be lost: wait for room (this is not a line thread). */
 		(void)k_msgq_put(&br_queue, &e, K_MSEC(1000));

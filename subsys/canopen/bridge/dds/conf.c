@@ -74,7 +74,7 @@ static bool parse_index(const char *s, size_t n, uint16_t *index)
 	if (n == 0U || n >= sizeof(buf)) {
 		return false;
 	}
-	memcpy(buf, s, n);
+	(void)memcpy(buf, s, n);
 	buf[n] = '\0';
 	if (n > 1U && (buf[n - 1] == 'h' || buf[n - 1] == 'H')) {
 		buf[n - 1] = '\0';
@@ -392,12 +392,12 @@ static int rule_line(struct br_conf *conf, const struct ctx *c, char **w, int n)
 			    CONFIG_CANOPEN_BRIDGE_DDS_ALLOW_RULES);
 	}
 	r = &conf->rules[conf->n_rules];
-	memset(r, 0, sizeof(*r));
+	(void)memset(r, 0, sizeof(*r));
 	r->nmt = nmt;
 	if (strlen(w[1]) >= sizeof(r->client)) {
 		return fail(c, "client pattern longer than %zu characters", sizeof(r->client) - 1U);
 	}
-	strcpy(r->client, w[1]);
+	(void)strcpy(r->client, w[1]);
 	err = parse_line_no(c, w[2], true, &r->line_no);
 	if (err == 0) {
 		err = parse_nodes(c, w[3], nmt, r->nodes);

@@ -56,7 +56,7 @@ static struct section *list_add(struct list *l)
 		l->v = v;
 		l->cap = cap;
 	}
-	memset(&l->v[l->n], 0, sizeof(l->v[0]));
+	(void)memset(&l->v[l->n], 0, sizeof(l->v[0]));
 	return &l->v[l->n++];
 }
 
@@ -64,7 +64,7 @@ static char *trim(char *s)
 {
 	char *e;
 
-	while (isspace((unsigned char)*s)) {
+	while (isspace((unsigned char)*s) != 0) {
 		s++;
 	}
 	e = s + strlen(s);
@@ -197,6 +197,8 @@ static int build(struct br_eds *eds, struct list *objs, struct list *subs)
 			}
 		} else if (o->dtype != 0U) {
 			err = add_entry(eds, &cap, o->index, 0U, o->dtype, o->access, o->name);
+		} else {
+			/* A plain VAR without a data type has nothing to list. */
 		}
 	}
 	if (err == 0 && eds->n > 1U) {
@@ -216,7 +218,7 @@ int br_eds_load(const char *path, struct br_eds *eds)
 	int err = 0;
 	FILE *f;
 
-	memset(eds, 0, sizeof(*eds));
+	(void)memset(eds, 0, sizeof(*eds));
 	(void)snprintf(eds->path, sizeof(eds->path), "%s", path);
 	f = fopen(path, "r");
 	if (f == NULL) {
@@ -257,6 +259,9 @@ int br_eds_load(const char *path, struct br_eds *eds)
 				cur->index = index;
 				cur->sub = sub;
 				cur->access = NO_ACCESS;
+			} else {
+				/* Another section ([FileInfo], comments ...): its keys are skipped.
+				 */
 			}
 			continue;
 		}
@@ -286,6 +291,8 @@ int br_eds_load(const char *path, struct br_eds *eds)
 			cur->objtype = (uint8_t)v;
 		} else if (strcasecmp(s, "CompactSubObj") == 0 && parse_num(eq, &v) && v <= 254U) {
 			cur->compact = (uint8_t)v;
+		} else {
+			/* Other keys, or a value out of range, are not used by the bridge. */
 		}
 	}
 	(void)fclose(f);

@@ -103,10 +103,10 @@ static bool requester_ready(dds_entity_t rd, dds_entity_t wr, dds_instance_handl
 		(void)nanosleep(&step, NULL);
 	}
 	if (waited) {
-		atomic_inc(&br.replies_deferred);
+		(void)atomic_inc(&br.replies_deferred);
 	}
 	if (st != 1) {
-		atomic_inc(&br.replies_lost);
+		(void)atomic_inc(&br.replies_lost);
 		return false;
 	}
 	known[known_next++ % KNOWN_REQUESTERS] = pub;
@@ -333,7 +333,7 @@ static void handle_sdo(const safeline_canopen_v1_SdoRequest *rq, dds_instance_ha
 		rq->timeout_ms != 0U ? rq->timeout_ms : CONFIG_CANOPEN_BRIDGE_DDS_SDO_TIMEOUT;
 	bool write = rq->op == safeline_canopen_v1_SDO_WRITE;
 
-	atomic_inc(&br.requests);
+	(void)atomic_inc(&br.requests);
 	br_client_name(rq->client_id, client, sizeof(client));
 	if (rq->client_id[0] == '\0' || rq->request_id == 0U) {
 		set_result(&r, safeline_canopen_v1_STATUS_MALFORMED,
@@ -370,7 +370,7 @@ static void handle_sdo(const safeline_canopen_v1_SdoRequest *rq, dds_instance_ha
 			   "%s: client '%s' may not write %04Xh:%02X of node %u on line %u",
 			   br.conf.allow ? "not in the allow-list" : "the bridge is read-only",
 			   client, rq->index, rq->subindex, rq->node_id, rq->line);
-		atomic_inc(&br.refused);
+		(void)atomic_inc(&br.refused);
 	} else {
 		bool described = describe(slot, rq->line, rq->node_id, rq->index, rq->subindex, &r);
 		struct br_bnode *b = br_bnode_at(slot, rq->node_id);
@@ -403,7 +403,7 @@ static void handle_sdo(const safeline_canopen_v1_SdoRequest *rq, dds_instance_ha
 	if (r.status == safeline_canopen_v1_STATUS_MALFORMED ||
 	    r.status == safeline_canopen_v1_STATUS_UNKNOWN_LINE ||
 	    r.status == safeline_canopen_v1_STATUS_UNKNOWN_NODE) {
-		atomic_inc(&br.malformed);
+		(void)atomic_inc(&br.malformed);
 	}
 	if (r.status != safeline_canopen_v1_STATUS_OK) {
 		r.data = NULL;
@@ -479,7 +479,7 @@ static void handle_nmt(const safeline_canopen_v1_NmtRequest *rq, dds_instance_ha
 	uint8_t bit = br_cmd_bit(rq->command);
 	uint8_t status = safeline_canopen_v1_STATUS_OK;
 
-	atomic_inc(&br.requests);
+	(void)atomic_inc(&br.requests);
 	br_client_name(rq->client_id, client, sizeof(client));
 	if (rq->client_id[0] == '\0' || rq->request_id == 0U) {
 		status = safeline_canopen_v1_STATUS_MALFORMED;
@@ -509,14 +509,14 @@ static void handle_nmt(const safeline_canopen_v1_NmtRequest *rq, dds_instance_ha
 		(void)snprintf(msg, sizeof(msg), "%s: client '%s' may not send %s to %s on line %u",
 			       br.conf.allow ? "not in the allow-list" : "the bridge is read-only",
 			       client, names[__builtin_ctz(bit)], target, rq->line);
-		atomic_inc(&br.refused);
+		(void)atomic_inc(&br.refused);
 	} else {
 		status = nmt_send(slot, rq->node_id, rq->command, msg, sizeof(msg));
 	}
 	if (status == safeline_canopen_v1_STATUS_MALFORMED ||
 	    status == safeline_canopen_v1_STATUS_UNKNOWN_LINE ||
 	    status == safeline_canopen_v1_STATUS_UNKNOWN_NODE) {
-		atomic_inc(&br.malformed);
+		(void)atomic_inc(&br.malformed);
 	}
 	send_nmt_reply(rq, pub, status, msg);
 }
@@ -561,6 +561,9 @@ static uint64_t poll_remote_objects(uint64_t now_us)
 				} else if (err == -EAGAIN) {
 					br_publish_value(o, CO_SDO_AB_TIMEOUT, NULL, 0U,
 							 co_line_now());
+				} else {
+					/* Another error (node gone, client busy): the next poll
+					 * tries again. */
 				}
 			}
 #endif
@@ -585,7 +588,7 @@ static bool for_us(const void *sample, bool sdo)
 
 void br_request_thread(void *p1, void *p2, void *p3)
 {
-	while (atomic_get(&br.running)) {
+	while (atomic_get(&br.running) != 0) {
 		uint64_t now = co_line_now();
 		uint64_t next = MIN(poll_remote_objects(now), now + 1000000U);
 		dds_attach_t hits[4];
@@ -621,5 +624,5 @@ void br_request_thread(void *p1, void *p2, void *p3)
 			}
 		} while (n > 0 && atomic_get(&br.running));
 	}
-	atomic_set(&br.req_done, 1);
+	(void)atomic_set(&br.req_done, 1);
 }
