@@ -364,8 +364,17 @@ struct co_mgr_sdom {
 	uint8_t op, end, scan_id, srv_num, conn, slave, srd;
 	uint8_t pool[2];
 	bool rel_active;
-	bool trig;      /* a 6E0h came: scan when idle */
-	bool own_write; /* our writes of 1F02h/1F03h pass the hook */
+	bool trig;                                    /* a 6E0h came: scan when idle */
+	bool own_write;                               /* our writes of 1F02h/1F03h pass the hook */
+	bool reqec[CONFIG_CANOPEN_MGR_SDOM_SRDS];     /* ... asked for error control of slaves */
+	uint8_t stale[CONFIG_CANOPEN_MGR_SDOM_CONNS]; /* release writes refused: 1 SRD, 2 slave */
+	bool tried[CONFIG_CANOPEN_MGR_SDOM_CONNS];    /* taken by the running release */
+	uint32_t dead[4];  /* node-IDs that did not answer within the running release */
+	uint32_t lost[4];  /* node-IDs whose error control failed, still to handle */
+	uint8_t fail_side; /* sides of the running release whose writes failed (as stale) */
+	bool wait;         /* a step waits for a slave's boot to leave its default SDO */
+	uint8_t up_node, up_sub;
+	uint16_t up_index; /* the upload that waits */
 };
 /** @endcond */
 #endif /* CONFIG_CANOPEN_MGR_SDOM */

@@ -134,6 +134,9 @@ static void ec_event(struct co_mgr_slave *s, enum co_mgr_ec_event ev)
 		ev == CO_MGR_EC_HB_LOST ? "heartbeat lost" : "node guarding lost");
 	co_mgr_set_nmt_view(s, 0x01U);
 	ec_indicate(m, s->id, ev, 0x01U);
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+	co_mgr_sdom_lost(m, s->id);
+#endif
 	error_handler(s);
 }
 
@@ -257,6 +260,9 @@ void co_mgr_ec_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	byte = frame->data[0];
 	s = co_mgr_slot_find(m, id);
 	if (byte == 0U) {
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+		co_mgr_sdom_bootup(m, id);
+#endif
 		if (s != NULL) {
 			s->await_bootup = false;
 		}

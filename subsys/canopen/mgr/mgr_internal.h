@@ -14,7 +14,7 @@
  * - mgr_startup.c  the NMT startup: reset, boot all, 1F89h, halt, start all / individual
  * - mgr_od.c       the hooks on 1F80h-1F83h and the 1F82h read value
  * - mgr_fm.c       flying master (1F90h) and NMT master detection (1F91h)
- * - mgr_sdom.c     SDO manager: 6E0h registration, 1F00h-1F03h (dynamic SDO connections)
+ * - mgr_sdom.c     SDO manager: 6E0h registration, 1F00h-1F06h (dynamic SDO connections)
  *
  * Every function here runs with the node's mutex held.
  */
@@ -248,8 +248,14 @@ uint8_t co_mgr_pgm_resume_sdo(struct co_mgr_slave *s, uint32_t ab);
 /* --- mgr_sdom.c: SDO manager ------------------------------------------------------------------ */
 
 #if defined(CONFIG_CANOPEN_MGR_SDOM)
-/* Receive 6E0h and hook 1F00h-1F03h. */
+/* Receive 6E0h and hook 1F00h-1F06h. */
 int co_mgr_sdom_init(struct co_mgr *m);
+/* The error control of node @p id failed (mgr_ec.c): release an SRD's connections, or tell
+ * the SRDs that asked for error control that slave @p id failed (1F11h).
+ */
+void co_mgr_sdom_lost(struct co_mgr *m, uint8_t id);
+/* Node @p id sent its boot-up: entries it kept after a failed release are gone. */
+void co_mgr_sdom_bootup(struct co_mgr *m, uint8_t id);
 #endif
 
 #endif /* SAFELINE_SUBSYS_CANOPEN_MGR_MGR_INTERNAL_H_ */

@@ -6,7 +6,8 @@
 /*
  * SDO manager (CiA 302 §7, doc/sdo-manager.md): registration of SDO requesting devices
  * (SRDs) on 6E0h, connections to slaves on request (1F00h), releases (1F01h), the COB-ID
- * pool 1F02h and the connection table 1F03h.
+ * pool 1F02h, the connection table 1F03h-1F06h, and the error control of SRDs (their loss
+ * releases their connections) and, on request (1F10h Req EC), of their slaves (1F11h).
  *
  * One operation runs at a time over one SDO client (the node's last one) bound to the
  * default SDO of the node it talks to; 1F00h/1F01h writes that arrive meanwhile wait in a
@@ -30,7 +31,9 @@ LOG_MODULE_REGISTER(co_mgr_sdom, CONFIG_CANOPEN_LOG_LEVEL);
 #define IDX_REL_SDO  0x1F01U
 #define IDX_POOL     0x1F02U
 #define IDX_CONN     0x1F03U
+#define IDX_CONN_END 0x1F06U
 #define IDX_SRD_STAT 0x1F10U
+#define IDX_SRD_FAIL 0x1F11U
 #define IDX_SRV_PAR  0x1200U
 #define IDX_CLI_PAR  0x1280U
 #define TRIGGER_ID   0x6E0U
@@ -38,6 +41,13 @@ LOG_MODULE_REGISTER(co_mgr_sdom, CONFIG_CANOPEN_LOG_LEVEL);
 #define COB_INVALID BIT(31)
 #define COB_USED    BIT(30)
 #define COB_EXT     BIT(29)
+
+/* Sides of a connection whose release writes failed (stale[]). */
+#define SIDE_CLIENT BIT(0)
+#define SIDE_SERVER BIT(1)
+
+/* A step that would use a booting slave's default SDO looks again after this [ms]. */
+#define BOOT_WAIT_MS 10U
 
 /* 1F10h: Rq indication, connection state (bits 2..1), Req EC, error code, index. */
 #define ST_RQ           BIT(0)
@@ -58,7 +68,8 @@ enum {
 	END_REG,
 	END_CONN,
 	END_REL,
-	END_STATUS
+	END_STATUS,
+	END_ALL
 };
 
 static struct co_sdo_cli *cli(struct co_mgr *m)
@@ -114,12 +125,55 @@ static uint32_t pool_cobid(struct co_mgr *m, uint8_t sub)
 	return co_mgr_od(m, IDX_POOL, sub) & ~(COB_INVALID | COB_USED);
 }
 
+/*
+ * Connection k (1..) is the k-th entry of 1F03h, then of 1F04h-1F06h (302 §7.2.3: parts 2-4
+ * take up where the one before ends), each with as many entries as its sub 0 says.
+ */
+static uint8_t conn_count(struct co_mgr *m)
+{
+	uint32_t n = 0U;
+
+	for (uint16_t idx = IDX_CONN; idx <= IDX_CONN_END; idx++) {
+		n += subs(m, idx);
+	}
+	return (uint8_t)MIN(n, (uint32_t)CONFIG_CANOPEN_MGR_SDOM_CONNS);
+}
+
+static uint16_t conn_loc(struct co_mgr *m, uint8_t k, uint8_t *sub)
+{
+	uint8_t left = k;
+	uint16_t idx = IDX_CONN;
+
+	while (idx < IDX_CONN_END && left > subs(m, idx)) {
+		left -= subs(m, idx);
+		idx++;
+	}
+	*sub = left;
+	return idx;
+}
+
+static uint32_t conn_get(struct co_mgr *m, uint8_t k)
+{
+	uint8_t sub;
+	uint16_t idx = conn_loc(m, k, &sub);
+
+	return co_mgr_od(m, idx, sub);
+}
+
+static void conn_put(struct co_mgr *m, uint8_t k, uint32_t v)
+{
+	uint8_t sub;
+	uint16_t idx = conn_loc(m, k, &sub);
+
+	od_put32(m, idx, sub, v);
+}
+
 static uint8_t conn_free(struct co_mgr *m)
 {
-	uint8_t n = MIN(subs(m, IDX_CONN), CONFIG_CANOPEN_MGR_SDOM_CONNS);
+	uint8_t n = conn_count(m);
 
 	for (uint8_t i = 1U; i <= n; i++) {
-		uint32_t c = co_mgr_od(m, IDX_CONN, i);
+		uint32_t c = conn_get(m, i);
 
 		if ((uint8_t)c == 0U || (uint8_t)(c >> 16) == 0U) {
 			return i;
@@ -130,10 +184,10 @@ static uint8_t conn_free(struct co_mgr *m)
 
 static bool default_taken(struct co_mgr *m, uint8_t slave)
 {
-	uint8_t n = MIN(subs(m, IDX_CONN), CONFIG_CANOPEN_MGR_SDOM_CONNS);
+	uint8_t n = conn_count(m);
 
 	for (uint8_t i = 1U; i <= n; i++) {
-		uint32_t c = co_mgr_od(m, IDX_CONN, i);
+		uint32_t c = conn_get(m, i);
 
 		if ((uint8_t)c == slave && (uint8_t)(c >> 8) == 0U && (uint8_t)(c >> 16) != 0U) {
 			return true;
@@ -181,19 +235,100 @@ static void add_status(struct co_mgr *m, uint8_t srd, uint32_t v)
 
 static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data);
 
+/* Connections of @p srd the running release has not taken yet. */
 static uint8_t n_conns_of(struct co_mgr *m, uint8_t srd)
 {
-	uint8_t n = MIN(subs(m, IDX_CONN), CONFIG_CANOPEN_MGR_SDOM_CONNS);
+	uint8_t n = conn_count(m);
 	uint8_t k = 0U;
 
 	for (uint8_t i = 1U; i <= n; i++) {
-		uint32_t c = co_mgr_od(m, IDX_CONN, i);
+		uint32_t c = conn_get(m, i);
 
-		if ((uint8_t)(c >> 16) == srd && (uint8_t)c != 0U) {
+		if ((uint8_t)(c >> 16) == srd && (uint8_t)c != 0U && !m->sdom.tried[i - 1U]) {
 			k++;
 		}
 	}
 	return k;
+}
+
+static bool bit_get(const uint32_t *map, uint8_t id)
+{
+	return (map[id / 32U] & BIT(id % 32U)) != 0U;
+}
+
+static void bit_set(uint32_t *map, uint8_t id, bool on)
+{
+	if (on) {
+		map[id / 32U] |= BIT(id % 32U);
+	} else {
+		map[id / 32U] &= ~BIT(id % 32U);
+	}
+}
+
+/* Whether the boot process of @p id runs: its default SDO belongs to the boot (302 §7.1). */
+static bool booting(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_slave *s = co_mgr_slot_find(m, id);
+
+	return s != NULL && s->booting;
+}
+
+/* Look again once the boot had time to go on; the step is taken up by work_handler(). */
+static void wait_boot(struct co_mgr *m)
+{
+	m->sdom.wait = true;
+	co_node_timer_start(m->node, &m->sdom.work, co_mgr_now(m) + MS_US(BOOT_WAIT_MS));
+}
+
+/* Connection k is gone: table entry and pool pair free. */
+static void conn_drop(struct co_mgr *m, uint8_t k)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	conn_put(m, k, 0U);
+	for (int j = 0; j < 2; j++) {
+		if (d->cpool[k - 1U][j] != 0U) {
+			pool_mark(m, d->cpool[k - 1U][j], false);
+			d->cpool[k - 1U][j] = 0U;
+		}
+	}
+	d->stale[k - 1U] = 0U;
+}
+
+/*
+ * Error control of node @p id by the NMT master's means (302 §7.2.1 step 5): heartbeat when
+ * our 1016h has a consumer time for it, else node guarding with 1F81h's guard time and retry
+ * factor. Nothing configured: not supervised (logged).
+ */
+static void supervise(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_slave *s = co_mgr_slot_get(m, id);
+	uint32_t as = co_mgr_assign(m, id);
+	uint16_t hb = co_mgr_hb_time(m, id);
+
+	if (s == NULL || s->hb_on || s->guarding || s->booting) {
+		/* No slot (logged), already supervised, or the boot starts it. */
+		return;
+	}
+	if (hb != 0U) {
+		s->hb_ms = hb;
+		co_mgr_hb_start(s, co_mgr_now(m));
+	} else if ((uint16_t)(as >> 16) != 0U && (uint8_t)(as >> 8) != 0U) {
+		co_mgr_guard_start(s, (uint16_t)(as >> 16), (uint8_t)(as >> 8));
+	} else {
+		LOG_WRN("SDO manager: no heartbeat or guarding configured for node %u", id);
+	}
+}
+
+/* A de-registered SRD that is no NMT slave of ours leaves its slot. */
+static void unsupervise(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_slave *s = co_mgr_slot_find(m, id);
+
+	if (s != NULL && (co_mgr_assign(m, id) & AS_SLAVE) == 0U && !s->booting) {
+		co_mgr_ec_stop(s);
+		s->id = 0U;
+	}
 }
 
 static void start_upload(struct co_mgr *m, uint8_t node, uint16_t index, uint8_t sub)
@@ -202,6 +337,13 @@ static void start_upload(struct co_mgr *m, uint8_t node, uint16_t index, uint8_t
 	uint32_t timeout = d->op == OP_SCAN ? CONFIG_CANOPEN_MGR_SDOM_SCAN_TIMEOUT
 					    : CONFIG_CANOPEN_MGR_SDO_TIMEOUT;
 
+	d->up_node = node;
+	d->up_index = index;
+	d->up_sub = sub;
+	if (booting(m, node)) {
+		wait_boot(m);
+		return;
+	}
 	if (co_sdo_cli_set_server(cli(m), node) != 0 ||
 	    co_sdo_cli_upload_req(cli(m), index, sub, d->buf, sizeof(d->buf), CO_SDO_CLI_AUTO,
 				  timeout, con, m) != 0) {
@@ -219,6 +361,16 @@ static void step_write(struct co_mgr *m)
 		struct co_mgr_sdom_wr *w = &d->wr[d->i_wr];
 
 		sys_put_le32(w->val, d->buf);
+		if (d->end == END_REL && bit_get(d->dead, w->node)) {
+			/* It did not answer within this release: not asked again, left stale. */
+			d->fail_side |= w->node == d->srd ? SIDE_CLIENT : SIDE_SERVER;
+			d->i_wr++;
+			continue;
+		}
+		if (w->node != own_id(m) && booting(m, w->node)) {
+			wait_boot(m);
+			return;
+		}
 		if (w->node == own_id(m)) {
 			/* Our own server entry of the SRD's channel: no SDO. */
 			(void)co_od_write(&m->node->od, w->index, w->sub, d->buf, w->len,
@@ -237,15 +389,25 @@ static void step_write(struct co_mgr *m)
 		}
 		return;
 	}
-	/* The table follows the writes: a failed write of a release still frees the entry. */
-	if (d->end == END_REL) {
-		od_put32(m, IDX_CONN, d->conn, 0U);
-		for (int k = 0; k < 2; k++) {
-			if (d->cpool[d->conn - 1U][k] != 0U) {
-				pool_mark(m, d->cpool[d->conn - 1U][k], false);
-				d->cpool[d->conn - 1U][k] = 0U;
-			}
-		}
+	if (d->end == END_REL && d->fail_side == 0U) {
+		conn_drop(m, d->conn);
+	} else if (d->end == END_REL) {
+		/*
+		 * A device that refused or did not answer may still use the COB-IDs: the
+		 * entry and its pool pair stay until that device boots (its entries are back
+		 * to their defaults) or a later 1F01h gets the writes through.
+		 */
+		d->stale[d->conn - 1U] = d->fail_side;
+		LOG_WRN("SDO manager: connection %u kept as stale (%s side)", d->conn,
+			d->fail_side == SIDE_SERVER ? "server" : "client");
+	} else if (d->end == END_REG || d->end == END_ALL) {
+		supervise(m, d->srd);
+	} else if (d->end == END_CONN && srd_find(m, d->srd) >= 0 &&
+		   d->reqec[srd_find(m, d->srd)]) {
+		/* 302 §7.2.2: the SRD asked for error control of its slaves. */
+		supervise(m, d->slave);
+	} else {
+		/* A failure status written: nothing follows. */
 	}
 	d->op = OP_NONE;
 	kick(m);
@@ -267,7 +429,7 @@ static void conn_default(struct co_mgr *m)
 {
 	struct co_mgr_sdom *d = &m->sdom;
 
-	od_put32(m, IDX_CONN, d->conn,
+	conn_put(m, d->conn,
 		 ((uint32_t)(d->idx - IDX_CLI_PAR) << 24) | ((uint32_t)d->srd << 16) | d->slave);
 	d->srv_num = 0U;
 	d->n_wr = 0U;
@@ -291,13 +453,7 @@ static void undo(struct co_mgr *m)
 	struct co_mgr_sdom *d = &m->sdom;
 	uint8_t end = d->end;
 
-	od_put32(m, IDX_CONN, d->conn, 0U);
-	for (int k = 0; k < 2; k++) {
-		if (d->cpool[d->conn - 1U][k] != 0U) {
-			pool_mark(m, d->cpool[d->conn - 1U][k], false);
-			d->cpool[d->conn - 1U][k] = 0U;
-		}
-	}
+	conn_drop(m, d->conn);
 	d->n_wr = 0U;
 	d->i_wr = 0U;
 	d->end = END_STATUS;
@@ -327,7 +483,7 @@ static void conn_dynamic(struct co_mgr *m, uint8_t num)
 	uint16_t srv = IDX_SRV_PAR + num;
 
 	use_pair(m);
-	od_put32(m, IDX_CONN, d->conn,
+	conn_put(m, d->conn,
 		 ((uint32_t)(d->idx - IDX_CLI_PAR) << 24) | ((uint32_t)d->srd << 16) |
 			 ((uint32_t)num << 8) | d->slave);
 	d->n_wr = 0U;
@@ -381,8 +537,11 @@ static void registered(struct co_mgr *m, uint8_t id, uint32_t v)
 	if (v == ST_ALL_DEFAULTS) {
 		d->srds[slot] = id;
 		d->all[slot] = true;
+		d->reqec[slot] = false;
+		d->srd = id;
 		/* Nothing to set up: the SRD uses the default SDOs (state 2). */
 		status_only(m, id, ST_STATE(2));
+		d->end = END_ALL;
 		return;
 	}
 	for (uint8_t n = 1U; n < 128U && srv == 0U; n++) {
@@ -403,10 +562,11 @@ static void registered(struct co_mgr *m, uint8_t id, uint32_t v)
 	}
 	d->srds[slot] = id;
 	d->all[slot] = false;
+	d->reqec[slot] = (v & ST_REQ_EC) != 0U;
 	d->srd = id;
 	d->srv_num = srv;
 	use_pair(m);
-	od_put32(m, IDX_CONN, d->conn,
+	conn_put(m, d->conn,
 		 ((uint32_t)(idx - IDX_CLI_PAR) << 24) | ((uint32_t)id << 16) |
 			 ((uint32_t)srv << 8) | own_id(m));
 	d->n_wr = 0U;
@@ -418,8 +578,8 @@ static void registered(struct co_mgr *m, uint8_t id, uint32_t v)
 	add_wr(m, id, idx, 3U, own_id(m), 1U);
 	add_wr(m, id, idx, 1U, pool_cobid(m, d->pool[0]), 4U);
 	add_wr(m, id, idx, 2U, pool_cobid(m, d->pool[1]), 4U);
-	/* Req EC cleared: this manager does not start error control for the SRD's slaves. */
-	add_status(m, id, ((uint32_t)idx << 16) | ST_STATE(1));
+	/* Req EC echoed: the slaves of its connections will be supervised (1F11h). */
+	add_status(m, id, ((uint32_t)idx << 16) | ST_STATE(1) | (v & ST_REQ_EC));
 	d->op = OP_WRITE;
 	step_write(m);
 }
@@ -490,6 +650,12 @@ static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data)
 				undo(m);
 				return;
 			}
+			if (d->end == END_REL && w->index != IDX_SRD_FAIL) {
+				d->fail_side |= w->node == d->srd ? SIDE_CLIENT : SIDE_SERVER;
+				if (ab == CO_SDO_AB_TIMEOUT) {
+					bit_set(d->dead, w->node, true);
+				}
+			}
 		}
 		d->i_wr++;
 		step_write(m);
@@ -508,24 +674,28 @@ static bool release_next(struct co_mgr *m, uint32_t v)
 	uint16_t idx = (uint16_t)(v >> 16);
 	uint8_t srd = (uint8_t)(v >> 8);
 	uint8_t slave = (uint8_t)v;
-	uint8_t n = MIN(subs(m, IDX_CONN), CONFIG_CANOPEN_MGR_SDOM_CONNS);
+	uint8_t n = conn_count(m);
 
 	for (uint8_t i = 1U; i <= n; i++) {
-		uint32_t c = co_mgr_od(m, IDX_CONN, i);
+		uint32_t c = conn_get(m, i);
 		uint16_t ci = (uint16_t)(IDX_CLI_PAR + (c >> 24));
 		uint8_t srv = (uint8_t)(c >> 8);
 		uint8_t s = (uint8_t)c;
 		bool reg = s == own_id(m);
 
 		/* Slave 0: everything of the SRD, its own channel to us last. */
-		if ((uint8_t)(c >> 16) != srd || s == 0U || (slave != 0U && s != slave) ||
+		if ((uint8_t)(c >> 16) != srd || s == 0U || d->tried[i - 1U] ||
+		    (slave != 0U && s != slave) ||
 		    (slave == 0U && reg && n_conns_of(m, srd) > 1U) || (idx != 0U && ci != idx)) {
 			continue;
 		}
+		d->tried[i - 1U] = true;
 		d->n_wr = 0U;
 		d->i_wr = 0U;
 		d->end = END_REL;
 		d->conn = i;
+		d->srd = srd;
+		d->fail_side = 0U;
 		/* The client entry on the SRD first: it stops using the channel. */
 		add_wr(m, srd, ci, 1U, COB_INVALID, 4U);
 		add_wr(m, srd, ci, 2U, COB_INVALID, 4U);
@@ -536,6 +706,78 @@ static bool release_next(struct co_mgr *m, uint32_t v)
 		d->op = OP_WRITE;
 		step_write(m);
 		return true;
+	}
+	return false;
+}
+
+/* A release starts: every entry may be taken once, every device is asked again. */
+static void release_begin(struct co_mgr *m, uint32_t v)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	(void)memset(d->tried, 0, sizeof(d->tried));
+	(void)memset(d->dead, 0, sizeof(d->dead));
+	d->rel_active = true;
+	d->rel_val = v;
+}
+
+/*
+ * Slave @p id failed (302 §7.2.2): each SRD that asked for error control learns it through
+ * its 1F11h (reason 00h), then its client entry for the slave is cleared. The slave is not
+ * written: a dynamic entry it still holds keeps its pool pair until it boots. False when no
+ * such connection is left.
+ */
+static bool slave_failed_next(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+	uint8_t n = conn_count(m);
+
+	for (uint8_t i = 1U; i <= n; i++) {
+		uint32_t c = conn_get(m, i);
+		uint8_t srd = (uint8_t)(c >> 16);
+		uint16_t ci = (uint16_t)(IDX_CLI_PAR + (c >> 24));
+		int k = srd_find(m, srd);
+
+		if ((uint8_t)c != id || srd == 0U || k < 0 || !d->reqec[k] ||
+		    d->stale[i - 1U] != 0U) {
+			continue;
+		}
+		(void)memset(d->dead, 0, sizeof(d->dead));
+		d->n_wr = 0U;
+		d->i_wr = 0U;
+		d->end = END_REL;
+		d->conn = i;
+		d->srd = srd;
+		d->fail_side = (uint8_t)(c >> 8) != 0U ? SIDE_SERVER : 0U;
+		add_wr(m, srd, IDX_SRD_FAIL, 0U, id, 2U);
+		add_wr(m, srd, ci, 1U, COB_INVALID, 4U);
+		add_wr(m, srd, ci, 2U, COB_INVALID, 4U);
+		d->op = OP_WRITE;
+		step_write(m);
+		return true;
+	}
+	return false;
+}
+
+/* Handle the next lost node; false when none is left. */
+static bool lost_next(struct co_mgr *m)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	for (uint8_t id = 1U; id <= 127U; id++) {
+		if (!bit_get(d->lost, id)) {
+			continue;
+		}
+		if (srd_find(m, id) >= 0) {
+			/* The SRD failed: everything it held is released, it is de-registered. */
+			bit_set(d->lost, id, false);
+			release_begin(m, (uint32_t)id << 8);
+			return true;
+		}
+		if (slave_failed_next(m, id)) {
+			return true;
+		}
+		bit_set(d->lost, id, false);
 	}
 	return false;
 }
@@ -584,8 +826,13 @@ static void next(struct co_mgr *m)
 				if (i >= 0) {
 					d->srds[i] = 0U;
 					d->all[i] = false;
+					d->reqec[i] = false;
+					unsupervise(m, (uint8_t)(d->rel_val >> 8));
 				}
 			}
+			continue;
+		}
+		if (lost_next(m)) {
 			continue;
 		}
 		if (d->n_q > 0U) {
@@ -594,8 +841,7 @@ static void next(struct co_mgr *m)
 			memmove(&d->q[0], &d->q[1], (d->n_q - 1U) * sizeof(d->q[0]));
 			d->n_q--;
 			if (q.kind == IDX_REL_SDO) {
-				d->rel_active = true;
-				d->rel_val = q.val;
+				release_begin(m, q.val);
 			} else if (q.kind == IDX_REQ_SDO) {
 				request(m, q.val);
 			} else {
@@ -624,6 +870,24 @@ static uint32_t enqueue(struct co_mgr *m, uint16_t kind, uint32_t v)
 	return CO_OD_HANDLED;
 }
 
+/*
+ * The SDO manager works while its NMT master is the active one (302 §4: manager functions
+ * run only on the active master): 1F80h bit 0, and with the flying master the won
+ * negotiation.
+ */
+static bool sdom_active(struct co_mgr *m)
+{
+	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
+		return false;
+	}
+#if defined(CONFIG_CANOPEN_MGR_FLYING)
+	if ((co_mgr_startup_obj(m) & SU_FLYING) != 0U && !co_mgr_fm_active(m)) {
+		return false;
+	}
+#endif
+	return true;
+}
+
 /* 1F00h: refusals that are known now abort the write (060A0023h) and still tell the SRD. */
 static uint32_t req_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
@@ -640,8 +904,8 @@ static uint32_t req_validate(struct co_od *od, struct co_od_req *req, void *user
 	if (req->len != 4U) {
 		return CO_SDO_AB_TYPE_MISMATCH;
 	}
-	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
-		/* Only the manager (1F80h bit 0) hands out connections. */
+	if (!sdom_active(m)) {
+		/* Only the active manager (1F80h bit 0) hands out connections. */
 		return CO_SDO_AB_DATA_DEV_STATE;
 	}
 	if (i < 0 || m->sdom.all[i]) {
@@ -673,8 +937,8 @@ static uint32_t rel_validate(struct co_od *od, struct co_od_req *req, void *user
 	if (req->len != 4U) {
 		return CO_SDO_AB_TYPE_MISMATCH;
 	}
-	if ((co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
-		/* Only the manager (1F80h bit 0) hands out connections. */
+	if (!sdom_active(m)) {
+		/* Only the active manager (1F80h bit 0) hands out connections. */
 		return CO_SDO_AB_DATA_DEV_STATE;
 	}
 	if (srd_find(m, (uint8_t)(v >> 8)) < 0 || (uint8_t)v > 127U ||
@@ -684,21 +948,21 @@ static uint32_t rel_validate(struct co_od *od, struct co_od_req *req, void *user
 	return enqueue(m, IDX_REL_SDO, v);
 }
 
-/* 1F02h is changed by tools only while no connection uses it; 1F03h is ours. */
+/* 1F02h is changed by tools only while no connection uses it; 1F03h-1F06h are ours. */
 static uint32_t table_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_mgr *m = user_data;
-	uint8_t n = MIN(subs(m, IDX_CONN), CONFIG_CANOPEN_MGR_SDOM_CONNS);
+	uint8_t n = conn_count(m);
 
 	ARG_UNUSED(od);
 	if (m->sdom.own_write || req->writer == CO_OD_WRITER_STORAGE) {
 		return 0U;
 	}
-	if (req->info->index == IDX_CONN) {
+	if (req->info->index >= IDX_CONN) {
 		return CO_SDO_AB_READONLY;
 	}
 	for (uint8_t i = 1U; i <= n; i++) {
-		if ((uint8_t)(co_mgr_od(m, IDX_CONN, i) >> 16) != 0U) {
+		if ((uint8_t)(conn_get(m, i) >> 16) != 0U) {
 			return CO_SDO_AB_DATA_DEV_STATE;
 		}
 	}
@@ -716,7 +980,54 @@ static void work_handler(struct co_timer *timer, uint64_t now_us)
 		con(cli(m), ab, 0U, m);
 		return;
 	}
+	if (m->sdom.wait) {
+		/* The step that waited for a slave's boot: try it again. */
+		m->sdom.wait = false;
+		if (m->sdom.op == OP_WRITE) {
+			step_write(m);
+		} else {
+			start_upload(m, m->sdom.up_node, m->sdom.up_index, m->sdom.up_sub);
+		}
+		return;
+	}
 	next(m);
+}
+
+void co_mgr_sdom_lost(struct co_mgr *m, uint8_t id)
+{
+	if (id == 0U || id > 127U) {
+		return;
+	}
+	bit_set(m->sdom.lost, id, true);
+	/* Handled from the timer, when the running operation has ended. */
+	if (m->sdom.op == OP_NONE) {
+		kick(m);
+	}
+}
+
+void co_mgr_sdom_bootup(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+	uint8_t n = conn_count(m);
+
+	for (uint8_t i = 1U; i <= n; i++) {
+		uint32_t c = conn_get(m, i);
+
+		if (d->stale[i - 1U] == 0U || (d->op != OP_NONE && d->conn == i)) {
+			continue;
+		}
+		/* Its reset brought its SDO entries back to their defaults. */
+		if ((uint8_t)(c >> 16) == id) {
+			d->stale[i - 1U] &= (uint8_t)~SIDE_CLIENT;
+		}
+		if ((uint8_t)c == id) {
+			d->stale[i - 1U] &= (uint8_t)~SIDE_SERVER;
+		}
+		if (d->stale[i - 1U] == 0U) {
+			LOG_INF("SDO manager: stale connection %u freed (node %u booted)", i, id);
+			conn_drop(m, i);
+		}
+	}
 }
 
 static void trigger_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
@@ -725,7 +1036,7 @@ static void trigger_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t
 
 	ARG_UNUSED(now_us);
 	/* Only the manager (1F80h bit 0) answers; every other node ignores 6E0h. */
-	if (frame->dlc != 0U || (co_mgr_startup_obj(m) & SU_MASTER) == 0U) {
+	if (frame->dlc != 0U || !sdom_active(m)) {
 		return;
 	}
 	m->sdom.trig = true;
@@ -753,7 +1064,7 @@ int co_mgr_sdom_init(struct co_mgr *m)
 		},
 		{
 			.index_first = IDX_POOL,
-			.index_last = IDX_CONN,
+			.index_last = IDX_CONN_END,
 			.sub_first = 1,
 			.sub_last = 255,
 			.validate = table_validate,

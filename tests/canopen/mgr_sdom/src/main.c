@@ -20,6 +20,7 @@
 #include <zephyr/ztest.h>
 
 #include <canopen/mgr.h>
+#include <canopen/nmt.h>
 #include <canopen/node.h>
 #include <canopen/sdo_abort.h>
 #include <canopen/sdo_cli.h>
@@ -258,6 +259,18 @@ static uint32_t od_w(int i, uint16_t index, uint8_t sub, uint32_t v, enum co_od_
 	return ab;
 }
 
+static void od_w16(int i, uint16_t index, uint8_t sub, uint16_t v)
+{
+	uint8_t b[2];
+
+	sys_put_le16(v, b);
+	co_node_lock(&t.n[i].node);
+	zassert_equal(co_od_write(co_node_od(&t.n[i].node), index, sub, b, 2, CO_OD_WRITER_APP),
+		      0U);
+	co_node_unlock(&t.n[i].node);
+	settle();
+}
+
 /* Manager with a pool of @p pool COB-IDs from 6C0h; all four nodes started and settled. */
 static void network(int pool)
 {
@@ -314,9 +327,9 @@ static uint32_t srd_download(uint8_t num, uint16_t index, uint8_t sub, uint32_t 
 	return sdo.ab;
 }
 
-static uint32_t srd_upload(uint8_t num, uint16_t index, uint8_t sub, uint32_t *v)
+static uint32_t upload_on(int i, uint8_t num, uint16_t index, uint8_t sub, uint32_t *v)
 {
-	struct co_node *n = &t.n[SRD].node;
+	struct co_node *n = &t.n[i].node;
 	int err;
 
 	memset(&sdo, 0, sizeof(sdo));
@@ -329,6 +342,11 @@ static uint32_t srd_upload(uint8_t num, uint16_t index, uint8_t sub, uint32_t *v
 	zassert_true(sdo.done);
 	*v = sys_get_le32(sdo.buf);
 	return sdo.ab;
+}
+
+static uint32_t srd_upload(uint8_t num, uint16_t index, uint8_t sub, uint32_t *v)
+{
+	return upload_on(SRD, num, index, sub, v);
 }
 
 /* Whether a frame with CAN-ID @p id was on the bus since @p since. */
@@ -363,9 +381,32 @@ static void srd_register(uint32_t req)
 	run_ms(1000);
 }
 
-static uint32_t conn(uint8_t sub)
+/* Connection @p k: 1F03h:01..03, then 1F04h:01..03 (the manager dictionary's sizes). */
+static uint32_t conn(uint8_t k)
 {
-	return od_u(MGR, 0x1F03, sub);
+	return k <= 3U ? od_u(MGR, 0x1F03, k) : od_u(MGR, 0x1F04, (uint8_t)(k - 3U));
+}
+
+/* Let node @p i reset its communication (it sends its boot-up). */
+static void node_reset(int i)
+{
+	co_node_lock(&t.n[i].node);
+	zassert_ok(co_nmt_req(&t.n[i].node, CO_NMT_CS_RESET_COMMUNICATION));
+	co_node_unlock(&t.n[i].node);
+	settle();
+}
+
+/* Frames with CAN-ID @p id since @p since. */
+static int count(uint32_t id, uint64_t since)
+{
+	int n = 0;
+
+	for (int i = 0; i < t.n_log; i++) {
+		if (t.log[i].at >= since && t.log[i].f.id == id) {
+			n++;
+		}
+	}
+	return n;
 }
 
 #define REQ(idx, srd, s) (((uint32_t)(idx) << 16) | ((uint32_t)(srd) << 8) | (s))
@@ -689,6 +730,219 @@ ZTEST(co_mgr_sdom, test_srd_helpers)
 	zassert_equal(conn(1), 0U);
 	zassert_equal(conn(2), 0U);
 	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
+}
+
+/* SDO download requests (ccs 1) on CAN-ID @p id since @p since. */
+static int count_downloads(uint32_t id, uint64_t since)
+{
+	int n = 0;
+
+	for (int i = 0; i < t.n_log; i++) {
+		if (t.log[i].at >= since && t.log[i].f.id == id &&
+		    (t.log[i].f.data[0] & 0xE0U) == 0x20U) {
+			n++;
+		}
+	}
+	return n;
+}
+
+/* --- Error control (302 §7.2.1 step 5, §7.2.2) ------------------------------------------------ */
+
+#define SRD2       4
+#define ID_SRD2    0x7DU
+#define HB(id, ms) (((uint32_t)(id) << 16) | (ms))
+
+/* The manager consumes the SRD's heartbeat (250 ms); the SRD produces it every 100 ms. */
+static void srd_heartbeat(void)
+{
+	cfg(MGR, 0x1016, 1, HB(ID_SRD, 250U), 4);
+	cfg(SRD, 0x1017, 0, 100U, 2);
+}
+
+/* The SRD's heartbeat stops (it still answers SDO): all it held is released, de-registered. */
+ZTEST(co_mgr_sdom, test_srd_heartbeat_lost_releases)
+{
+	srd_heartbeat();
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "Req EC not asked, not set");
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	run_ms(1000);
+	zassert_not_equal(conn(3), 0U, "kept while the heartbeat runs");
+	od_w16(SRD, 0x1017, 0, 0U);
+	run_ms(1000);
+	for (uint8_t k = 1U; k <= 6U; k++) {
+		zassert_equal(conn(k), 0U, "connection %u", k);
+		zassert_equal(od_u(MGR, 0x1F02, k), POOL0 + k - 1U, "1F02h:%u", k);
+	}
+	zassert_equal(od_u(SRD, 0x1280, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE, "de-registered");
+	/* Not registered any more: the scan finds it again. */
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
+}
+
+/* "All default SDOs" is given back by stopping the error control, which de-registers. */
+ZTEST(co_mgr_sdom, test_all_default_sdos_given_back_by_heartbeat)
+{
+	srd_heartbeat();
+	network(6);
+	srd_register(0x00000003U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000004U);
+	run_ms(1000);
+	/* Still registered: a new 6E0h scan skips it, 1F10h keeps the request. */
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800001U, "still holds the default SDOs");
+	od_w16(SRD, 0x1017, 0, 0U);
+	run_ms(1000);
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "de-registered, registers anew");
+}
+
+/*
+ * The SRD dies: its client entries cannot be written (one try, then no more within the
+ * release), the slaves' entries are; the table entries and pool pairs stay as stale until the
+ * SRD's boot-up shows its entries are back to their defaults.
+ */
+ZTEST(co_mgr_sdom, test_srd_dead_entries_stale_until_bootup)
+{
+	uint64_t t0;
+
+	srd_heartbeat();
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	t.n[SRD].alive = false;
+	t0 = t.now;
+	run_ms(2000);
+	zassert_equal(count_downloads(0x600U + ID_SRD, t0), 1, "the dead SRD is asked once");
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31), "the slave's entry released");
+	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31), "our own entry released");
+	for (uint8_t k = 1U; k <= 3U; k++) {
+		zassert_not_equal(conn(k), 0U, "connection %u kept as stale", k);
+	}
+	for (uint8_t k = 1U; k <= 4U; k++) {
+		zassert_equal(od_u(MGR, 0x1F02, k) & BIT(30), BIT(30), "1F02h:%u still in use", k);
+	}
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE, "de-registered");
+	/* It comes back with a reset: its entries are the defaults again, the stale ones go. */
+	t.n[SRD].alive = true;
+	node_reset(SRD);
+	run_ms(10);
+	for (uint8_t k = 1U; k <= 6U; k++) {
+		zassert_equal(conn(k), 0U, "connection %u", k);
+		zassert_equal(od_u(MGR, 0x1F02, k), POOL0 + k - 1U, "1F02h:%u", k);
+	}
+}
+
+/* Req EC (1F10h = iiii0009h): a failed slave is reported in 1F11h, its client entries cleared. */
+ZTEST(co_mgr_sdom, test_req_ec_slave_failed)
+{
+	srd_heartbeat();
+	cfg(MGR, 0x1016, 2, HB(ID_SLV, 250U), 4);
+	cfg(SLV, 0x1017, 0, 100U, 2);
+	network(6);
+	srd_register(0x12800009U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x1280000AU, "Req EC kept: supported");
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	run_ms(1000);
+	zassert_equal(od_u(SRD, 0x1F11, 0), 0U, "alive");
+	t.n[SLV].alive = false;
+	run_ms(1000);
+	zassert_equal(od_u(SRD, 0x1F11, 0), ID_SLV, "reason 00h, slave 0Ah");
+	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
+	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31));
+	zassert_equal(conn(2), 0U, "the default SDO connection is gone");
+	zassert_not_equal(conn(3), 0U, "the slave may still hold 6C2h/6C3h: stale");
+	zassert_equal(od_u(MGR, 0x1F02, 3) & BIT(30), BIT(30));
+	zassert_not_equal(conn(1), 0U, "the SRD stays registered");
+	/* The slave boots again: its server entry is invalid, the pair is free. */
+	t.n[SLV].alive = true;
+	node_reset(SLV);
+	run_ms(10);
+	zassert_equal(conn(3), 0U);
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
+	zassert_equal(od_u(MGR, 0x1F02, 4), POOL0 + 3U);
+}
+
+/* A release the slave does not answer keeps the entry; a later 1F01h gets it through. */
+ZTEST(co_mgr_sdom, test_release_unanswered_kept_then_retried)
+{
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	t.n[SLV].alive = false;
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	run_ms(500);
+	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31), "the SRD's side released");
+	zassert_not_equal(conn(3), 0U, "kept: the slave may still use the COB-IDs");
+	zassert_equal(od_u(MGR, 0x1F02, 3) & BIT(30), BIT(30));
+	/* The slave is back without a reset (it still holds the entry): the release again. */
+	t.n[SLV].alive = true;
+	zassert_equal(od_u(SLV, 0x1201, 1), POOL0 + 2U);
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
+	zassert_equal(conn(3), 0U);
+	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
+	zassert_not_equal(conn(2), 0U, "the other connection untouched");
+}
+
+/* 1F03h full (3 entries here): the next connection is 1F04h:01. */
+ZTEST(co_mgr_sdom, test_connections_part_2)
+{
+	uint32_t v;
+
+	node_add(SRD2, ID_SRD2, &sdom_srd_od_def);
+	network(6);
+	srd_register(0x12800001U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_PLAIN)), 0U);
+	zassert_not_equal(od_u(MGR, 0x1F03, 3), 0U);
+	zassert_equal(od_w(SRD2, 0x1F10, 0, 0x12800001U, CO_OD_WRITER_APP), 0U);
+	inject(0x6E0, 0, 0, 0);
+	run_ms(1000);
+	zassert_equal(od_u(SRD2, 0x1F10, 0), 0x12800002U);
+	zassert_equal(od_u(MGR, 0x1F04, 1), ((uint32_t)ID_SRD2 << 16) | (2U << 8) | ID_MGR,
+		      "1F04h:01, our 1202h");
+	zassert_equal(upload_on(SRD2, 0, 0x1F04, 1, &v), 0U, "the channel works");
+	zassert_equal(v, ((uint32_t)ID_SRD2 << 16) | (2U << 8) | ID_MGR);
+	zassert_equal(srd_download(0, 0x1F04, 1, 0), CO_SDO_AB_READONLY);
+	/* Released like the others. */
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, 0)), 0U);
+	zassert_not_equal(od_u(MGR, 0x1F04, 1), 0U, "another SRD's");
+	zassert_equal(od_u(MGR, 0x1F03, 1), 0U);
+}
+
+/* A slave's default SDO is the boot's while its boot runs: the connection waits for its end. */
+ZTEST(co_mgr_sdom, test_connection_waits_for_boot)
+{
+	uint64_t t0;
+
+	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
+	/* The boot's "start error control" waits 500 ms for a heartbeat that never comes. */
+	cfg(MGR, 0x1016, 1, HB(ID_SLV, 500U), 4);
+	network(6);
+	srd_register(0x12800001U);
+	node_reset(SLV);
+	run_ms(50);
+	t0 = t.now;
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO), 0U);
+	run_ms(200);
+	zassert_equal(count(0x600U + ID_SLV, t0), 0, "no SDO manager transfer during the boot");
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "not yet");
+	run_ms(1000);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12810006U, "set up once the boot ended");
+	zassert_true(seen(0x600U + ID_SLV, t0));
 }
 
 ZTEST_SUITE(co_mgr_sdom, NULL, NULL, before, after, NULL);
