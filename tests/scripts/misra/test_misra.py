@@ -160,3 +160,59 @@ LIST(DECL)
     want = "int v1=1 * 10 + 0 * 20 + 0 * 40; int v2=3; int v3=5; int v4=7 + 80; int a; int c;"
     assert tokens(gcc) == want
     assert tokens(cpp) == want
+
+
+def test_counts_prints_the_violations_per_rule(probe, tmp_path):
+    r = run("--counts", str(probe), out=tmp_path / "out")
+    assert r.returncode == 1, r.stdout + r.stderr
+    rows = [ln.split() for ln in r.stdout.splitlines()]
+    assert ["rule", "total", "deviated", "not", "files"] in rows
+    assert ["15.6", "1", "0", "1", "1"] in rows
+    # The violations not deviated are still listed, one per line; the per-file listing is not.
+    assert f"{probe}:9:" in r.stdout and "(NOT DEVIATED)" in r.stdout
+    assert "by rule and file" not in r.stdout
+
+    devs = tmp_path / "devs.md"
+    devs.write_text("## Deviations\n\n| rule | where | why |\n|---|---|---|\n"
+                    f"| 15.6 | `{tmp_path}/*.c` | the probe |\n")
+    r = run("--counts", "--deviations", str(devs), str(probe), out=tmp_path / "out")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert ["15.6", "1", "1", "0", "1"] in [ln.split() for ln in r.stdout.splitlines()]
+
+
+def test_a_pattern_that_deviates_nothing_is_reported(probe, tmp_path):
+    """A row or one of its patterns that no violation needs is named (to be removed or
+    narrowed); it does not fail the check. A partial run names only the patterns whose files
+    it checked all."""
+    devs = tmp_path / "devs.md"
+    devs.write_text("## Deviations\n\n| rule | where | why |\n|---|---|---|\n"
+                    f"| 15.6 | `{probe}`, `{tmp_path}/other/*.c` | the probe |\n"
+                    f"| 15.5 | `{tmp_path}/probe*.c` | nothing needs it |\n"
+                    "| 15.6 | `subsys/canopen/*` | not checked here |\n")
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "unchecked.c").write_text("/* no violation here */\n")
+    r = run("--deviations", str(devs), str(probe), out=tmp_path / "out")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "deviations no violation needs any more" in r.stdout
+    assert f"devs.md:6: rule 15.5 `{tmp_path}/probe*.c` deviates nothing" in r.stdout
+    # The used pattern, a pattern with a file not checked, and the stack's rows: not named.
+    assert f"`{probe}` deviates nothing" not in r.stdout
+    assert "other/*.c` deviates nothing" not in r.stdout
+    assert "subsys/canopen/*` deviates nothing" not in r.stdout
+
+    # With every file of the pattern checked, the pattern that deviates nothing is named.
+    r = run("--deviations", str(devs), str(probe), str(tmp_path / "other"),
+            out=tmp_path / "out")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert f"devs.md:5: rule 15.6 `{tmp_path}/other/*.c` deviates nothing" in r.stdout
+    assert f"`{probe}` deviates nothing" not in r.stdout
+
+
+def test_unused_patterns_of_a_full_run():
+    rows = [({"10.4"}, ["subsys/a.c", "subsys/b.c"], 3), ({"15.5", "2.7"}, ["subsys/*"], 4)]
+    viol = [{"rule": "10.4", "file": "subsys/a.c", "deviation": 3},
+            {"rule": "15.5", "file": "subsys/b.c", "deviation": 4}]
+    assert misra.unused_patterns(viol, rows) == [(3, {"10.4"}, "subsys/b.c")]
+    assert misra.unused_patterns([], rows) == [(3, {"10.4"}, "subsys/a.c"),
+                                               (3, {"10.4"}, "subsys/b.c"),
+                                               (4, {"15.5", "2.7"}, "subsys/*")]
