@@ -43,6 +43,12 @@ LOG_MODULE_REGISTER(co_sdo_cli, CONFIG_CANOPEN_LOG_LEVEL);
 #define CLI_PST       ((uint8_t)CONFIG_CANOPEN_SDO_CLIENT_PST)
 /* Pause before offering a block download segment again to a full TX queue. */
 #define TX_RETRY_US   1000U
+/*
+ * Places of the line's TX queue a block download leaves free, a quarter of it: a sub-block
+ * of 127 segments would otherwise fill the queue, and a heartbeat, a PDO or the answer of
+ * another node on the same line that comes while it is full is dropped.
+ */
+#define TX_RESERVE    MAX(2, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE / 4)
 /* How many times a timeout is put off while our own frames wait in the line's TX queue. */
 #define TX_WAITS_MAX  8U
 /* Clients 0..127 have a parameter object (1280h-12FFh). */
@@ -276,8 +282,8 @@ static void blk_dn_sub_begin(struct co_sdo_cli *cli)
 }
 
 /*
- * Send the segments of the sub-block not sent yet. Pause before the line's TX queue
- * overflows and go on from the timer (as the server does in block uploads).
+ * Send the segments of the sub-block not sent yet, as the line has room: pause while no
+ * more than TX_RESERVE places are free and go on from the timer as the queue drains.
  */
 static void blk_dn_send(struct co_sdo_cli *cli, uint64_t now)
 {
@@ -293,8 +299,8 @@ static void blk_dn_send(struct co_sdo_cli *cli, uint64_t now)
 		if (chunk > 0U) {
 			memcpy(&d[1], &cli->dn_data[o], chunk);
 		}
-		err = co_node_tx_space(cli->node, CO_ROUTE_ACTIVE) > 0 ? cli_send(cli, d)
-								       : -ENOBUFS;
+		err = co_node_tx_space(cli->node, CO_ROUTE_ACTIVE) > TX_RESERVE ? cli_send(cli, d)
+										: -ENOBUFS;
 		if (err == -ENOBUFS) {
 			cli->stats.tx_retries++;
 			cli->retry_at = now + TX_RETRY_US;

@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: Apache-2.0
  */
 
+#include <errno.h>
 #include <string.h>
 
 #include <zephyr/sys/byteorder.h>
@@ -16,7 +17,14 @@ static int sink(struct co_line *line, const struct can_frame *frame, void *user_
 	if (h.sink_result != 0) {
 		return h.sink_result;
 	}
+	if (h.bus_paced) {
+		if (h.bus_credit == 0) {
+			return -EAGAIN;
+		}
+		h.bus_credit--;
+	}
 	zassert_true(h.wr - h.rd < RING, "frame ring overflow");
+	h.ring_at[h.wr % RING] = h.now;
 	h.ring[h.wr++ % RING] = *frame;
 	return 0;
 }

@@ -62,7 +62,14 @@ struct harness {
 	struct can_frame ring[RING];
 	uint32_t wr;
 	uint32_t rd;
+	/* When each frame of ring[] reached the bus. */
+	uint64_t ring_at[RING];
 	int sink_result;
+	/* A bus of limited rate: while set, the sink takes bus_credit more frames, then
+	 * pushes back (-EAGAIN).
+	 */
+	bool bus_paced;
+	int bus_credit;
 	uint64_t now;
 	struct con_rec con[4];
 };

@@ -289,7 +289,8 @@ ZTEST(sdo_cli_transfers, test_block_download_paced_by_tx_space)
 	co_line_get_stats(&h.line, &ls);
 	zassert_true(ls.tx_queued > 0U);
 	zassert_equal(ls.tx_dropped, 0U);
-	zassert_equal(co_line_tx_space(&h.line), 0);
+	/* The client stops with a quarter of the queue free for the line's other traffic. */
+	zassert_equal(co_line_tx_space(&h.line), MAX(2, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE / 4));
 	h.sink_result = 0;
 	h_run_for_con(rec, 10 * TIMEOUT_US);
 	zassert_equal(rec->calls, 1U);
@@ -304,6 +305,89 @@ ZTEST(sdo_cli_transfers, test_block_download_paced_by_tx_space)
 
 		co_sdo_cli_get_stats(h_cli(0), &cs);
 		zassert_true(cs.tx_retries > 0U);
+	}
+}
+
+/*
+ * A block download on a line of limited rate (one frame per 250 us, about 500 kbit/s) with a
+ * short TX queue (16) that it shares with the client node's heartbeat (20 ms): the client
+ * sends its sub-blocks of 127 segments as the queue has room, so the download completes,
+ * nothing is dropped, and every heartbeat goes out on time, late at most by the segments
+ * queued before it.
+ */
+ZTEST(sdo_cli_transfers, test_block_download_leaves_room_for_the_heartbeat)
+{
+	const uint16_t hb_ms = 20;
+	const uint64_t frame_us = 250;
+	/* What the client may have queued ahead of a heartbeat, sent at one frame per slot. */
+	const uint64_t late_us = (CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE -
+				  MAX(2, CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE / 4) + 1) *
+				 frame_us;
+	struct con_rec *rec = &h.con[0];
+	struct co_line_stats ls;
+	uint64_t start, end, prev = 0, hb_at[64];
+	uint32_t n_hb = 0, n_seg = 0, max_seq = 0, last_seq = 0;
+	size_t len;
+
+	BUILD_ASSERT(CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE < 128, "a sub-block must not fit the queue");
+	zassert_equal(h_od_write(&h.cnode, 0x1017, 0, &hb_ms, 2, CO_OD_WRITER_APP), 0U);
+	h_advance(1 * MS);
+	h_fill(out, DOM_SIZE, 91);
+	h.bus_paced = true;
+	h.rd = h.wr;
+	start = h.now;
+	zassert_ok(co_sdo_cli_download_req(h_cli(0), 0x2005, 0, out, DOM_SIZE, CO_SDO_CLI_BLOCK, 0,
+					   h_con, rec));
+	while (rec->calls == 0U && h.now < start + 5000 * MS) {
+		/* The bus takes one frame per slot. */
+		h.bus_credit = 1;
+		co_line_process(&h.line, h.now);
+		h_advance(frame_us);
+	}
+	/* Two heartbeat periods more, to see the one after the download too. */
+	end = h.now + 2U * hb_ms * MS;
+	while (h.now < end) {
+		h.bus_credit = 1;
+		co_line_process(&h.line, h.now);
+		h_advance(frame_us);
+	}
+	zassert_equal(rec->calls, 1U);
+	zassert_equal(rec->code, 0U, "download %08x", rec->code);
+	srv_read(0x2005, in, sizeof(in), &len);
+	zassert_equal(len, DOM_SIZE);
+	zassert_mem_equal(in, out, DOM_SIZE);
+	co_line_get_stats(&h.line, &ls);
+	zassert_equal(ls.tx_dropped, 0U, "no frame of the line dropped");
+
+	for (uint32_t i = h.rd; i != h.wr; i++) {
+		const struct can_frame *f = &h.ring[i % RING];
+
+		if (f->id == 0x700U + CLI_ID) {
+			zassert_true(n_hb < ARRAY_SIZE(hb_at));
+			hb_at[n_hb++] = h.ring_at[i % RING];
+		} else if (f->id == 0x600U + SRV_ID) {
+			/* Between the initiate and the end request: the segments. */
+			if (n_seg > 1U) {
+				max_seq = MAX(max_seq, last_seq);
+			}
+			last_seq = f->data[0] & 0x7FU;
+			n_seg++;
+		}
+	}
+	n_seg -= 2U;
+	zassert_equal(n_seg, DIV_ROUND_UP(DOM_SIZE, 7U), "every segment once (%u)", n_seg);
+	zassert_equal(max_seq, CONFIG_CANOPEN_SDO_BLOCK_MAX_BLKSIZE,
+		      "sub-blocks of the server's size");
+	zassert_true(n_hb >= (h.now - start) / (hb_ms * MS) - 1U, "%u heartbeats in %llu us", n_hb,
+		     (unsigned long long)(h.now - start));
+	for (uint32_t i = 0; i < n_hb; i++) {
+		if (i > 0U) {
+			uint64_t gap = hb_at[i] - prev;
+
+			zassert_true(gap + late_us >= hb_ms * MS && gap <= hb_ms * MS + late_us,
+				     "heartbeat %u after %llu us", i, (unsigned long long)gap);
+		}
+		prev = hb_at[i];
 	}
 }
 
