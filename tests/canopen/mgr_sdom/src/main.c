@@ -805,6 +805,33 @@ ZTEST(co_mgr_sdom, test_all_default_sdos_given_back_by_heartbeat)
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "de-registered, registers anew");
 }
 
+/* No 1016h entry for the SRD: node guarding with 1F81h's guard time and retry factor. */
+ZTEST(co_mgr_sdom, test_srd_guarded_without_heartbeat)
+{
+	uint64_t t0;
+	int rtr = 0;
+
+	/* Guard time 100 ms, retry factor 3; bit 0 clear: no NMT slave of ours. */
+	cfg(MGR, 0x1F81, ID_SRD, (100U << 16) | (3U << 8), 4);
+	network(6);
+	t0 = t.now;
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
+	for (int i = 0; i < t.n_log; i++) {
+		if (t.log[i].at >= t0 && t.log[i].f.id == 0x700U + ID_SRD &&
+		    (t.log[i].f.flags & CAN_FRAME_RTR) != 0U) {
+			rtr++;
+		}
+	}
+	zassert_true(rtr >= 8, "RTRs every 100 ms (%d)", rtr);
+	zassert_not_equal(conn(1), 0U, "its answers keep it");
+	t.n[SRD].alive = false;
+	run_ms(1000);
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_RESOURCE, "de-registered");
+	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31), "our entry released");
+}
+
 /*
  * The SRD dies: its client entries cannot be written (one try, then no more within the
  * release), the slaves' entries are; the table entries and pool pairs stay as stale until the
