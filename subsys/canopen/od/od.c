@@ -189,33 +189,83 @@ static void decode_fixed(uint8_t dtype, const uint8_t *in, void *mem)
 	store_native(mem, co_od_csize(dtype), v);
 }
 
-/* Numeric value of wire bytes, for limit checks. */
-static union co_od_num wire_num(uint8_t dtype, const uint8_t *in)
+/*
+ * The limit checks compare numbers as 64-bit unsigned keys whose order is the numbers' order,
+ * so that no class needs its own comparison and REAL values need no floating point (a
+ * soft-float target would link the library's double routines for two comparisons).
+ */
+
+/* The IEEE 754 binary64 bits of a binary32 value (exact: every float is a double). */
+static uint64_t real32_to_64(uint32_t b)
 {
-	union co_od_num n;
+	uint64_t sign = (uint64_t)(b >> 31) << 63;
+	uint32_t exp = (b >> 23) & 0xFFU;
+	uint32_t man = b & 0x7FFFFFU;
+
+	if (exp == 0xFFU) {
+		exp = 0x7FFU; /* infinity, NaN */
+	} else if (exp != 0U) {
+		exp += 1023U - 127U;
+	} else if (man != 0U) {
+		/* A subnormal float is a normal double: shift the leading one out. */
+		exp = 1023U - 126U;
+		while ((man & 0x800000U) == 0U) {
+			man <<= 1;
+			exp--;
+		}
+		man &= 0x7FFFFFU;
+	} else {
+		/* zero */
+	}
+	return sign | ((uint64_t)exp << 52) | ((uint64_t)man << 29);
+}
+
+/* Whether binary64 bits are a NaN, which compares neither below nor above anything. */
+static bool real_is_nan(uint64_t bits)
+{
+	return (bits << 1) > ((uint64_t)0x7FFU << 53);
+}
+
+/* The order key of a value of class @p cls. */
+static uint64_t num_key(enum co_dtype_class cls, uint64_t v)
+{
+	const uint64_t top = (uint64_t)1 << 63;
+
+	if (cls == CO_DTYPE_CLASS_INT) {
+		return v ^ top;
+	}
+	if (cls == CO_DTYPE_CLASS_REAL) {
+		if ((v << 1) == 0U) {
+			return top; /* -0 and +0 are equal */
+		}
+		return (v & top) != 0U ? ~v : (v | top);
+	}
+	return v;
+}
+
+/* a < b for two values of class @p cls; false when either is a NaN, as in C. */
+static bool num_lt(enum co_dtype_class cls, uint64_t a, uint64_t b)
+{
+	if (cls == CO_DTYPE_CLASS_REAL && (real_is_nan(a) || real_is_nan(b))) {
+		return false;
+	}
+	return num_key(cls, a) < num_key(cls, b);
+}
+
+/* Wire bytes as the 64-bit pattern of their class (sign-extended, REAL32 widened). */
+static uint64_t wire_num(uint8_t dtype, enum co_dtype_class cls, const uint8_t *in)
+{
 	uint32_t size = co_dtype_size(dtype);
 	uint64_t raw = co_od_le_get(in, size);
 
-	switch (co_dtype_class(dtype)) {
-	case CO_DTYPE_CLASS_INT:
-		n.i = (int64_t)sign_extend(raw, size);
-		break;
-	case CO_DTYPE_CLASS_REAL:
-		if (size == 4U) {
-			uint32_t bits = (uint32_t)raw;
-			float f;
-
-			memcpy(&f, &bits, sizeof(f));
-			n.f = f;
-		} else {
-			memcpy(&n.f, &raw, sizeof(n.f));
-		}
-		break;
-	default:
-		n.u = raw;
-		break;
+	if (cls == CO_DTYPE_CLASS_INT) {
+		raw = sign_extend(raw, size);
+	} else if (cls == CO_DTYPE_CLASS_REAL && size == 4U) {
+		raw = real32_to_64((uint32_t)raw);
+	} else {
+		/* UNSIGNED, BOOLEAN, REAL64: as they are */
 	}
-	return n;
+	return raw;
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -1011,20 +1061,9 @@ static uint32_t check_size(const struct co_od_info *info, size_t len)
 	}
 }
 
-static bool num_lt(enum co_dtype_class cls, union co_od_num a, union co_od_num b)
-{
-	switch (cls) {
-	case CO_DTYPE_CLASS_INT:
-		return a.i < b.i;
-	case CO_DTYPE_CLASS_REAL:
-		return a.f < b.f;
-	default:
-		return a.u < b.u;
-	}
-}
-
-static union co_od_num lim_val(const struct co_od *od, enum co_dtype_class cls, union co_od_num v,
-			       bool rel)
+/* A limit as the 64-bit pattern of its class, $NODEID added when it is relative. */
+static uint64_t lim_val(const struct co_od *od, enum co_dtype_class cls, union co_od_num v,
+			bool rel)
 {
 	if (rel) {
 		uint32_t nid = nid_or_zero(od->node_id);
@@ -1035,7 +1074,7 @@ static union co_od_num lim_val(const struct co_od *od, enum co_dtype_class cls, 
 			v.u += nid;
 		}
 	}
-	return v;
+	return v.u;
 }
 
 static uint32_t check_value(const struct co_od *od, const struct co_od_info *info,
@@ -1049,13 +1088,15 @@ static uint32_t check_value(const struct co_od *od, const struct co_od_info *inf
 	if (info->limit == NULL || cls == CO_DTYPE_CLASS_NONE || co_dtype_size(info->dtype) == 0U) {
 		return 0U;
 	}
-	union co_od_num v = wire_num(info->dtype, data);
 	const struct co_od_limit *l = info->limit;
+	uint64_t v = wire_num(info->dtype, cls, data);
+	uint64_t lo = lim_val(od, cls, l->lo, (l->rel & CO_OD_LIM_LO_REL) != 0U);
+	uint64_t hi = lim_val(od, cls, l->hi, (l->rel & CO_OD_LIM_HI_REL) != 0U);
 
-	if (num_lt(cls, v, lim_val(od, cls, l->lo, l->rel & CO_OD_LIM_LO_REL))) {
+	if (num_lt(cls, v, lo)) {
 		return CO_SDO_AB_VALUE_LOW;
 	}
-	if (num_lt(cls, lim_val(od, cls, l->hi, l->rel & CO_OD_LIM_HI_REL), v)) {
+	if (num_lt(cls, hi, v)) {
 		return CO_SDO_AB_VALUE_HIGH;
 	}
 	return 0U;
