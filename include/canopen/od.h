@@ -53,6 +53,12 @@ extern "C" {
 #else
 #define CO_OD_HOOKS_MAX 32
 #endif
+/* The hook-coverage cache: on unless a Kconfig build turned CONFIG_CANOPEN_OD_COVER off. */
+#if defined(CONFIG_CANOPEN_OD_COVER) || !defined(CONFIG_CANOPEN_OD)
+#define CO_OD_COVER 1
+#else
+#define CO_OD_COVER 0
+#endif
 /* Object providers: on unless a Kconfig build turned CONFIG_CANOPEN_OD_PROVIDERS off. */
 #if defined(CONFIG_CANOPEN_OD_PROVIDERS) || !defined(CONFIG_CANOPEN_OD)
 #define CO_OD_PROVIDERS 1
@@ -643,13 +649,15 @@ static inline bool co_od_cover_fast_(const struct co_od *od, const struct co_od_
  */
 static inline bool co_od_cover_plain_write(const struct co_od *od, const struct co_od_cover *cover)
 {
-	return cover->gen == od->hook_gen && (cover->flags & CO_OD_COVER_W_FAST) != 0U;
+	return CO_OD_COVER && cover->gen == od->hook_gen &&
+	       (cover->flags & CO_OD_COVER_W_FAST) != 0U;
 }
 
 /** @brief As co_od_cover_plain_write(), for a PDO/SRDO read: a copy of the value. */
 static inline bool co_od_cover_plain_read(const struct co_od *od, const struct co_od_cover *cover)
 {
-	return cover->gen == od->hook_gen && (cover->flags & CO_OD_COVER_R_FAST) != 0U;
+	return CO_OD_COVER && cover->gen == od->hook_gen &&
+	       (cover->flags & CO_OD_COVER_R_FAST) != 0U;
 }
 
 /**
@@ -705,6 +713,9 @@ static inline uint32_t co_od_write_cached(struct co_od *od, const struct co_od_i
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
 	co_od_assert_locked(od);
 #endif
+	if (!CO_OD_COVER) {
+		return co_od_write_info(od, info, data, len, writer);
+	}
 	if (co_od_cover_fast_(od, info, cover, CO_OD_COVER_W_FAST, len, writer) &&
 	    co_od_copy_word(od->ram + info->desc->offset, data, len)) {
 		co_od_cover_notify(od, info, cover, data, len, writer);
@@ -724,6 +735,9 @@ static inline uint32_t co_od_read_cached(const struct co_od *od, const struct co
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
 	co_od_assert_locked(od);
 #endif
+	if (!CO_OD_COVER) {
+		return co_od_read_info(od, info, 0, buf, cap, len, reader);
+	}
 	if (cap >= info->size &&
 	    co_od_cover_fast_(od, info, cover, CO_OD_COVER_R_FAST, info->size, reader) &&
 	    co_od_copy_word(buf, od->ram + info->desc->offset, info->size)) {

@@ -118,7 +118,9 @@ typedef void (*co_tpdo_ind_t)(struct co_node *node, uint16_t num, void *user_dat
 struct co_pdo_map_ent {
 	/* The object; info.index 0001h-0007h with no desc/prov marks a dummy entry. */
 	struct co_od_info info;
+#if CO_OD_COVER
 	struct co_od_cover cover; /* hooks covering the object, refreshed by the accessors */
+#endif
 #if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	uint8_t bits; /* mapped length */
 	bool whole;   /* the whole object, whole bytes: moved without masking */

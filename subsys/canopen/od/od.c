@@ -1165,6 +1165,19 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 /* Cached access (hot paths) */
 
 /* Whether the C storage of a fixed-size type holds its wire bytes as they are. */
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_od_assert_locked(const struct co_od *od)
+{
+	OD_ASSERT_LOCKED(od);
+}
+#endif
+
+/*
+ * The cached accessors (CONFIG_CANOPEN_OD_COVER): which hooks cover an object, found once per
+ * change of the hook table, and the copy-only paths of PDO and SRDO writes and reads.
+ */
+#if CO_OD_COVER
+
 static bool wire_is_storage(uint8_t dtype)
 {
 	uint32_t size = co_dtype_size(dtype);
@@ -1390,13 +1403,6 @@ static __attribute__((noinline)) uint32_t write_notify(struct co_od *od,
 	return 0U;
 }
 
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-void co_od_assert_locked(const struct co_od *od)
-{
-	OD_ASSERT_LOCKED(od);
-}
-#endif
-
 /* A stale cover: make it, then write through it. */
 static __attribute__((noinline)) uint32_t write_remade(struct co_od *od,
 						       const struct co_od_info *info,
@@ -1512,6 +1518,27 @@ uint32_t co_od_read_cover(const struct co_od *od, const struct co_od_info *info,
 	*len = info->size;
 	return 0U;
 }
+
+#else /* !CO_OD_COVER */
+
+/* Without the cache the cached accessors are the generic ones; the cover is not used. */
+uint32_t co_od_write_cover(struct co_od *od, const struct co_od_info *info,
+			   struct co_od_cover *cover, const void *data, size_t len,
+			   enum co_od_writer writer)
+{
+	(void)cover;
+	return co_od_write_info(od, info, data, len, writer);
+}
+
+uint32_t co_od_read_cover(const struct co_od *od, const struct co_od_info *info,
+			  struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
+			  enum co_od_writer reader)
+{
+	(void)cover;
+	return co_od_read_info(od, info, 0, buf, cap, len, reader);
+}
+
+#endif /* CO_OD_COVER */
 
 uint32_t co_od_write(struct co_od *od, uint16_t index, uint8_t sub, const void *data, size_t len,
 		     enum co_od_writer writer)

@@ -27,6 +27,16 @@
 #define CO_HOT_INLINE ALWAYS_INLINE
 #endif
 
+/*
+ * An entry's hook-coverage cache for the cached accessors of od.h; without
+ * CONFIG_CANOPEN_OD_COVER the entry has none and they do not use it.
+ */
+#if CO_OD_COVER
+#define CO_PDO_ENT_COVER(ent) (&(ent)->cover)
+#else
+#define CO_PDO_ENT_COVER(ent) ((struct co_od_cover *)NULL)
+#endif
+
 /* Largest data field of a classic CAN frame, in bits. */
 #define CO_PDO_MAX_BITS 64U
 
@@ -114,7 +124,7 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
 					     uint8_t data[8])
 {
-	if (likely(map->fast_gen == od->hook_gen)) {
+	if (CO_OD_COVER && likely(map->fast_gen == od->hook_gen)) {
 		uint8_t frame[8] = {0};
 		unsigned int off = 0;
 
@@ -139,7 +149,7 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 {
 	uint32_t gen = od->hook_gen;
 
-	if (likely(map->fast_gen == gen)) {
+	if (CO_OD_COVER && likely(map->fast_gen == gen)) {
 		unsigned int off = 0;
 
 		for (uint8_t i = 0; i < map->n; i++) {
@@ -147,7 +157,7 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 			unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
 
 			(void)co_od_copy_word(od->ram + ent->info.desc->offset, &data[off], bytes);
-			co_od_cover_notify(od, &ent->info, &ent->cover, &data[off], bytes,
+			co_od_cover_notify(od, &ent->info, CO_PDO_ENT_COVER(ent), &data[off], bytes,
 					   CO_OD_WRITER_PDO);
 			off += bytes;
 			/* A hook that changed the hook table: the rest entry by entry. */

@@ -128,7 +128,7 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 	uint32_t ab;
 
 	memset(out, 0, 8);
-	ab = co_od_read_cached(od, &ent->info, &ent->cover, out, cap, &len, reader);
+	ab = co_od_read_cached(od, &ent->info, CO_PDO_ENT_COVER(ent), out, cap, &len, reader);
 	if (ab != 0U) {
 		memset(out, 0, 8);
 		return ab;
@@ -159,7 +159,7 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 			buf[b / 8U] |= (uint8_t)(1U << (b % 8U));
 		}
 	}
-	return co_od_write_cached(od, &ent->info, &ent->cover, buf, size, writer);
+	return co_od_write_cached(od, &ent->info, CO_PDO_ENT_COVER(ent), buf, size, writer);
 }
 
 /* Whether every entry of a mapping is a plain copy now (see pdo_internal.h). */
@@ -174,8 +174,8 @@ static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool
 
 		if (!co_pdo_ent_whole(ent) || co_pdo_ent_is_dummy(ent) || ent->info.desc == NULL ||
 		    (bytes != 1U && bytes != 2U && bytes != 4U && bytes != 8U) ||
-		    !(rx ? co_od_cover_plain_write(od, &ent->cover)
-			 : co_od_cover_plain_read(od, &ent->cover))) {
+		    !(rx ? co_od_cover_plain_write(od, CO_PDO_ENT_COVER(ent))
+			 : co_od_cover_plain_read(od, CO_PDO_ENT_COVER(ent)))) {
 			return false;
 		}
 	}
@@ -201,8 +201,8 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 
 		if (!BITWISE || (map->bytewise && co_pdo_ent_whole(ent))) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
-			if (co_od_read_cached(od, &ent->info, &ent->cover, &data[off / 8U],
-					      co_pdo_ent_bits(ent) / 8U, &len,
+			if (co_od_read_cached(od, &ent->info, CO_PDO_ENT_COVER(ent),
+					      &data[off / 8U], co_pdo_ent_bits(ent) / 8U, &len,
 					      CO_OD_WRITER_PDO) != 0U) {
 				memset(&data[off / 8U], 0, co_pdo_ent_bits(ent) / 8U);
 			}
@@ -232,8 +232,8 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 
 		if (BITWISE ? map->bytewise && co_pdo_ent_whole(ent) : !co_pdo_ent_is_dummy(ent)) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
-			refused += co_od_write_cached(od, &ent->info, &ent->cover, &data[off],
-						      co_pdo_ent_bits(ent) / 8U,
+			refused += co_od_write_cached(od, &ent->info, CO_PDO_ENT_COVER(ent),
+						      &data[off], co_pdo_ent_bits(ent) / 8U,
 						      CO_OD_WRITER_PDO) != 0U;
 		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));
