@@ -88,6 +88,8 @@ static struct {
 	int pend_from[MAX_PEND];
 	int n_pend;
 	uint64_t now;
+	uint32_t su;      /* the manager's 1F80h, 01h when 0 */
+	uint32_t boot_ms; /* what network() lets run after the start, 2000 ms when 0 */
 } t;
 
 /* --- The bus -------------------------------------------------------------------------------- */
@@ -278,7 +280,7 @@ static void network(int pool)
 	node_add(SRD, ID_SRD, &sdom_srd_od_def);
 	node_add(SLV, ID_SLV, &sdom_slave_od_def);
 	node_add(PLAIN, ID_PLAIN, &sdom_plain_od_def);
-	cfg(MGR, 0x1F80, 0, 0x01, 4);
+	cfg(MGR, 0x1F80, 0, t.su != 0U ? t.su : 0x01U, 4);
 	for (int k = 0; k < pool; k++) {
 		cfg(MGR, 0x1F02, (uint8_t)(k + 1), POOL0 + (uint32_t)k, 4);
 	}
@@ -288,7 +290,7 @@ static void network(int pool)
 		}
 	}
 	/* The manager's startup resets the others (Reset Communication); let it end. */
-	run_ms(2000);
+	run_ms(t.boot_ms != 0U ? t.boot_ms : 2000U);
 }
 
 /* --- The SRD's SDO client ------------------------------------------------------------------- */
@@ -948,6 +950,32 @@ ZTEST(co_mgr_sdom, test_connections_part_2)
 	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, 0)), 0U);
 	zassert_not_equal(od_u(MGR, 0x1F04, 1), 0U, "another SRD's");
 	zassert_equal(od_u(MGR, 0x1F03, 1), 0U);
+}
+
+/* A flying master candidate is the SDO manager only once it won the negotiation. */
+ZTEST(co_mgr_sdom, test_flying_master_manager_once_active)
+{
+#if !defined(CONFIG_CANOPEN_MGR_FLYING)
+	ztest_test_skip();
+#else
+	uint64_t t0;
+
+	t.su = 0x21U;
+	t.boot_ms = 10U;
+	network(6);
+	t0 = t.now;
+	zassert_equal(od_w(SRD, 0x1F10, 0, 0x12800001U, CO_OD_WRITER_APP), 0U);
+	inject(0x6E0, 0, 0, 0);
+	run_ms(500);
+	zassert_false(seen(0x600U + 0x7FU, t0) || seen(0x600U + ID_SRD, t0),
+		      "6E0h ignored while negotiating");
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
+		      CO_SDO_AB_DATA_DEV_STATE);
+	/* Alone, it wins within about 3 s (1F90h defaults) and serves the SRD. */
+	run_ms(5000);
+	srd_register(0x12800001U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
+#endif
 }
 
 /* A slave's default SDO is the boot's while its boot runs: the connection waits for its end. */
