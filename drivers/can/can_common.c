@@ -45,6 +45,8 @@ int can_send(const struct device *dev, const struct can_frame *frame, k_timeout_
 		}
 	} else if (frame->id > CAN_STD_ID_MASK) {
 		return -EINVAL;
+	} else {
+		/* A standard identifier within 11 bits: valid. */
 	}
 	if ((frame->flags & CAN_FRAME_FDF) != 0U) {
 		if (frame->dlc > CANFD_MAX_DLC) {
@@ -52,6 +54,8 @@ int can_send(const struct device *dev, const struct can_frame *frame, k_timeout_
 		}
 	} else if (frame->dlc > CAN_MAX_DLC) {
 		return -EINVAL;
+	} else {
+		/* A classic frame of at most 8 bytes: valid. */
 	}
 
 	if (callback != NULL) {
@@ -59,13 +63,13 @@ int can_send(const struct device *dev, const struct can_frame *frame, k_timeout_
 	}
 
 	/* Blocking form: the timeout bounds the wait for queue space, not the transmission. */
-	k_sem_init(&ctx.done, 0, 1);
+	(void)k_sem_init(&ctx.done, 0, 1);
 	ctx.status = -EIO;
 	err = api->send(dev, frame, timeout, can_tx_sync_cb, &ctx);
 	if (err != 0) {
 		return err;
 	}
-	k_sem_take(&ctx.done, K_FOREVER);
+	(void)k_sem_take(&ctx.done, K_FOREVER);
 
 	return ctx.status;
 }
@@ -112,7 +116,7 @@ int can_filter_table_add(struct can_filter_slot *slots, int n, struct k_mutex *l
 {
 	int id = -ENOSPC;
 
-	k_mutex_lock(lock, K_FOREVER);
+	(void)k_mutex_lock(lock, K_FOREVER);
 	for (int i = 0; i < n; i++) {
 		if (slots[i].cb == NULL) {
 			slots[i].cb = cb;
@@ -122,7 +126,7 @@ int can_filter_table_add(struct can_filter_slot *slots, int n, struct k_mutex *l
 			break;
 		}
 	}
-	k_mutex_unlock(lock);
+	(void)k_mutex_unlock(lock);
 	return id;
 }
 
@@ -131,15 +135,15 @@ void can_filter_table_remove(struct can_filter_slot *slots, int n, struct k_mute
 	if (id < 0 || id >= n) {
 		return;
 	}
-	k_mutex_lock(lock, K_FOREVER);
+	(void)k_mutex_lock(lock, K_FOREVER);
 	slots[id].cb = NULL;
-	k_mutex_unlock(lock);
+	(void)k_mutex_unlock(lock);
 }
 
 void can_filter_table_deliver(const struct device *dev, struct can_filter_slot *slots, int n,
 			      struct k_mutex *lock, const struct can_frame *frame)
 {
-	k_mutex_lock(lock, K_FOREVER);
+	(void)k_mutex_lock(lock, K_FOREVER);
 	for (int i = 0; i < n; i++) {
 		struct can_filter_slot *s = &slots[i];
 
@@ -149,5 +153,5 @@ void can_filter_table_deliver(const struct device *dev, struct can_filter_slot *
 			s->cb(dev, &copy, s->user_data);
 		}
 	}
-	k_mutex_unlock(lock);
+	(void)k_mutex_unlock(lock);
 }

@@ -117,13 +117,13 @@ static void sc_can_if_found(char *argv, int offset)
 				 "expected <controller 0..%d>:<ifname> (at most %d characters)",
 				 SC_NUM_CTRL - 1, SC_IFNAMSIZ - 1);
 	}
-	memcpy(index_str, value, index_len);
+	(void)memcpy(index_str, value, index_len);
 	index_str[index_len] = '\0';
 	if (cmd_parse_uint(index_str, 0U, SC_NUM_CTRL - 1U, &index) != 0) {
 		cmd_option_error("can-if", value, "the controller is not a number in 0..%d",
 				 SC_NUM_CTRL - 1);
 	}
-	strcpy(sc_ifname_override[index], colon + 1);
+	(void)strcpy(sc_ifname_override[index], colon + 1);
 }
 
 static void sc_add_options(void)
@@ -160,7 +160,7 @@ static void sc_kconfig_ifname(int index, char out[SC_IFNAMSIZ])
 		size_t len = strcspn(p, ",");
 
 		if (len < SC_IFNAMSIZ) {
-			memcpy(out, p, len);
+			(void)memcpy(out, p, len);
 			out[len] = '\0';
 		}
 	}
@@ -174,7 +174,7 @@ static void sc_resolve_ifname(int index, char out[SC_IFNAMSIZ])
 {
 	for (int depth = 0; depth < SC_NUM_CTRL; depth++) {
 		if (sc_ifname_override[index][0] != '\0') {
-			strcpy(out, sc_ifname_override[index]);
+			(void)strcpy(out, sc_ifname_override[index]);
 		} else {
 			sc_kconfig_ifname(index, out);
 		}
@@ -348,14 +348,14 @@ static void sc_deliver(struct sc_data *d, const struct can_frame *frame, uint64_
 {
 	bool deliver;
 
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	deliver = sc_rx_fresh_locked(d, rx_real_ns) && d->common.started;
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 	if (deliver) {
 		can_filter_table_deliver(d->dev, d->filters, SC_MAX_FILTERS, &d->rx_lock, frame);
 	}
-	k_mutex_unlock(&d->rx_lock);
+	(void)k_mutex_unlock(&d->rx_lock);
 }
 
 static void sc_on_echo(struct sc_data *d, const struct can_frame *frame, uint64_t rx_real_ns)
@@ -365,7 +365,7 @@ static void sc_on_echo(struct sc_data *d, const struct can_frame *frame, uint64_
 	bool loopback;
 
 	/* The echo completes the oldest frame in flight whenever it comes, also while stopped. */
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (d->stale_echoes > 0U) {
 		d->stale_echoes--;
 		have = false;
@@ -373,7 +373,7 @@ static void sc_on_echo(struct sc_data *d, const struct can_frame *frame, uint64_
 		have = sc_pop_locked(d, &tx);
 	}
 	loopback = (d->common.mode & CAN_MODE_LOOPBACK) != 0U;
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	k_sem_give(&d->echo_seen);
 	if (loopback) {
@@ -402,10 +402,10 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 
 	socketcan_host_decode_error(hf, &err);
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (!sc_rx_fresh_locked(d, rx_real_ns)) {
 		/* news from before the last can_start(), which reset the state */
-		k_mutex_unlock(&d->lock);
+		(void)k_mutex_unlock(&d->lock);
 		return;
 	}
 	if (err.has_counters) {
@@ -440,7 +440,7 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 			n_aborted = sc_abort_locked(d, aborted);
 		}
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	if (changed) {
 		LOG_INF("%s (%s): state %d, tx %u rx %u", d->dev->name, d->ifname, (int)state,
@@ -489,13 +489,13 @@ static void sc_rx_thread(void *p1, void *p2, void *p3)
 			continue;
 		}
 
-		memset(&frame, 0, sizeof(frame));
+		(void)memset(&frame, 0, sizeof(frame));
 		frame.id = hf.id;
 		frame.dlc = hf.dlc;
 		frame.flags =
 			(uint8_t)(((hf.flags & SOCKETCAN_HOST_F_IDE) != 0U ? CAN_FRAME_IDE : 0U) |
 				  ((hf.flags & SOCKETCAN_HOST_F_RTR) != 0U ? CAN_FRAME_RTR : 0U));
-		memcpy(frame.data, hf.data, sizeof(frame.data));
+		(void)memcpy(frame.data, hf.data, sizeof(frame.data));
 #if defined(CONFIG_CAN_RX_TIMESTAMP)
 		frame.timestamp = (uint16_t)sc_rx_time_us(rx_ns);
 #endif
@@ -523,7 +523,7 @@ static int sc_start(const struct device *dev)
 	struct sc_data *d = sc_data(dev);
 	int rc = 0;
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EALREADY;
 	} else if (d->fd < 0) {
@@ -539,7 +539,7 @@ static int sc_start(const struct device *dev)
 		d->draining = true;
 		d->common.started = true;
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	return rc;
 }
@@ -558,26 +558,26 @@ static int sc_stop(const struct device *dev)
 	k_timepoint_t end = sys_timepoint_calc(K_MSEC(CONFIG_CAN_SOCKETCAN_STOP_DRAIN_MS));
 	uint16_t in_flight;
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (!d->common.started) {
-		k_mutex_unlock(&d->lock);
+		(void)k_mutex_unlock(&d->lock);
 		return -EALREADY;
 	}
 	d->common.started = false;
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	/* Barrier: a delivery that saw started before we cleared it ends before we return. */
-	k_mutex_lock(&d->rx_lock, K_FOREVER);
-	k_mutex_unlock(&d->rx_lock);
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
+	(void)k_mutex_unlock(&d->rx_lock);
 
 	/* Only the receive thread reads echoes: from its callbacks, do not wait for them. */
 	if (k_current_get() == &d->rx_thread) {
 		return 0;
 	}
 	for (;;) {
-		k_mutex_lock(&d->lock, K_FOREVER);
+		(void)k_mutex_lock(&d->lock, K_FOREVER);
 		in_flight = d->count;
-		k_mutex_unlock(&d->lock);
+		(void)k_mutex_unlock(&d->lock);
 		if (in_flight == 0U) {
 			break;
 		}
@@ -597,7 +597,7 @@ static int sc_set_mode(const struct device *dev, can_mode_t mode)
 	struct sc_data *d = sc_data(dev);
 	int rc = 0;
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EBUSY;
 	} else if ((mode & ~(can_mode_t)CAN_MODE_LOOPBACK) != 0U) {
@@ -605,7 +605,7 @@ static int sc_set_mode(const struct device *dev, can_mode_t mode)
 	} else {
 		d->common.mode = mode;
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	return rc;
 }
@@ -616,13 +616,13 @@ static int sc_set_bitrate(const struct device *dev, uint32_t bitrate)
 	int rc = 0;
 
 	/* Only recorded: the interface's bit rate is set on the host (ip link ... bitrate). */
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EBUSY;
 	} else {
 		d->bitrate = bitrate;
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	return rc;
 }
@@ -659,15 +659,17 @@ static int sc_send(const struct device *dev, const struct can_frame *frame, k_ti
 	hf.dlc = frame->dlc;
 	hf.flags = (uint8_t)(((frame->flags & CAN_FRAME_IDE) != 0U ? SOCKETCAN_HOST_F_IDE : 0U) |
 			     ((frame->flags & CAN_FRAME_RTR) != 0U ? SOCKETCAN_HOST_F_RTR : 0U));
-	memcpy(hf.data, frame->data, sizeof(hf.data));
+	(void)memcpy(hf.data, frame->data, sizeof(hf.data));
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (!d->common.started) {
 		rc = -ENETDOWN;
 	} else if (d->state == CAN_STATE_BUS_OFF) {
 		rc = -ENETUNREACH;
+	} else {
+		/* Started and not bus-off: the frame is sent below. */
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 	if (rc != 0) {
 		return rc;
 	}
@@ -677,7 +679,7 @@ static int sc_send(const struct device *dev, const struct can_frame *frame, k_ti
 	}
 
 	for (;;) {
-		k_mutex_lock(&d->lock, K_FOREVER);
+		(void)k_mutex_lock(&d->lock, K_FOREVER);
 		if (!d->common.started) {
 			rc = -ENETDOWN;
 		} else if (d->state == CAN_STATE_BUS_OFF) {
@@ -694,7 +696,7 @@ static int sc_send(const struct device *dev, const struct can_frame *frame, k_ti
 				d->count--;
 			}
 		}
-		k_mutex_unlock(&d->lock);
+		(void)k_mutex_unlock(&d->lock);
 
 		if (rc == 0) {
 			return 0;
@@ -734,14 +736,14 @@ static int sc_get_state(const struct device *dev, enum can_state *state,
 {
 	struct sc_data *d = sc_data(dev);
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (state != NULL) {
 		*state = d->common.started ? d->state : CAN_STATE_STOPPED;
 	}
 	if (err_cnt != NULL) {
 		*err_cnt = d->err_cnt;
 	}
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 
 	return 0;
 }
@@ -757,10 +759,10 @@ static void sc_set_state_change_callback(const struct device *dev,
 {
 	struct sc_data *d = sc_data(dev);
 
-	k_mutex_lock(&d->lock, K_FOREVER);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	d->common.state_change_cb = callback;
 	d->common.state_change_cb_user_data = user_data;
-	k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->lock);
 }
 
 static int sc_get_max_filters(const struct device *dev, bool ide)
@@ -824,11 +826,11 @@ static int sc_init(const struct device *dev)
 	d->state = CAN_STATE_ERROR_ACTIVE;
 	d->bitrate = cfg->common.bitrate;
 	d->common.mode = CAN_MODE_NORMAL;
-	k_mutex_init(&d->lock);
-	k_mutex_init(&d->rx_lock);
-	k_sem_init(&d->tx_slots, SC_TXQ_SIZE, SC_TXQ_SIZE);
-	k_sem_init(&d->echo_seen, 0, 1);
-	k_sem_init(&d->tx_idle, 0, 1);
+	(void)k_mutex_init(&d->lock);
+	(void)k_mutex_init(&d->rx_lock);
+	(void)k_sem_init(&d->tx_slots, SC_TXQ_SIZE, SC_TXQ_SIZE);
+	(void)k_sem_init(&d->echo_seen, 0, 1);
+	(void)k_sem_init(&d->tx_idle, 0, 1);
 
 	sc_resolve_ifname(cfg->index, d->ifname);
 	if (d->ifname[0] == '\0') {
@@ -847,10 +849,10 @@ static int sc_init(const struct device *dev)
 		return rc;
 	}
 
-	k_thread_create(&d->rx_thread, sc_stacks[cfg->index],
-			K_THREAD_STACK_SIZEOF(sc_stacks[cfg->index]), sc_rx_thread, d, NULL, NULL,
-			CONFIG_CAN_SOCKETCAN_RX_THREAD_PRIORITY, 0, K_NO_WAIT);
-	k_thread_name_set(&d->rx_thread, dev->name);
+	(void)k_thread_create(&d->rx_thread, sc_stacks[cfg->index],
+			      K_THREAD_STACK_SIZEOF(sc_stacks[cfg->index]), sc_rx_thread, d, NULL,
+			      NULL, CONFIG_CAN_SOCKETCAN_RX_THREAD_PRIORITY, 0, K_NO_WAIT);
+	(void)k_thread_name_set(&d->rx_thread, dev->name);
 	LOG_DBG("%s on %s", dev->name, d->ifname);
 
 	return 0;

@@ -56,8 +56,8 @@ int socketcan_host_open(const char *ifname)
 		return -errno;
 	}
 
-	memset(&ifr, 0, sizeof(ifr));
-	strncpy(ifr.ifr_name, ifname, sizeof(ifr.ifr_name) - 1);
+	(void)memset(&ifr, 0, sizeof(ifr));
+	(void)strncpy(ifr.ifr_name, ifname, sizeof(ifr.ifr_name) - 1U);
 	if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
 		rc = -errno;
 		goto fail;
@@ -75,7 +75,7 @@ int socketcan_host_open(const char *ifname)
 		goto fail;
 	}
 
-	memset(&addr, 0, sizeof(addr));
+	(void)memset(&addr, 0, sizeof(addr));
 	addr.can_family = AF_CAN;
 	addr.can_ifindex = ifr.ifr_ifindex;
 	if (bind(fd, (struct sockaddr *)&addr, sizeof(addr)) < 0) {
@@ -86,14 +86,14 @@ int socketcan_host_open(const char *ifname)
 	return fd;
 
 fail:
-	close(fd);
+	(void)close(fd);
 	return rc;
 }
 
 void socketcan_host_close(int fd)
 {
 	if (fd >= 0) {
-		close(fd);
+		(void)close(fd);
 	}
 }
 
@@ -106,14 +106,14 @@ int socketcan_host_is_up(const char *ifname)
 	if (fd < 0) {
 		return -errno;
 	}
-	memset(&ifr, 0, sizeof(ifr));
-	strncpy(ifr.ifr_name, ifname, sizeof(ifr.ifr_name) - 1);
+	(void)memset(&ifr, 0, sizeof(ifr));
+	(void)strncpy(ifr.ifr_name, ifname, sizeof(ifr.ifr_name) - 1U);
 	if (ioctl(fd, SIOCGIFFLAGS, &ifr) < 0) {
 		rc = -errno;
 	} else {
 		rc = ((ifr.ifr_flags & IFF_UP) != 0 && (ifr.ifr_flags & IFF_RUNNING) != 0) ? 1 : 0;
 	}
-	close(fd);
+	(void)close(fd);
 
 	return rc;
 }
@@ -123,7 +123,7 @@ int socketcan_host_send(int fd, const struct socketcan_host_frame *frame)
 	struct can_frame cf;
 	ssize_t n;
 
-	memset(&cf, 0, sizeof(cf));
+	(void)memset(&cf, 0, sizeof(cf));
 	cf.can_id = frame->id &
 		    (((frame->flags & SOCKETCAN_HOST_F_IDE) != 0U) ? CAN_EFF_MASK : CAN_SFF_MASK);
 	if ((frame->flags & SOCKETCAN_HOST_F_IDE) != 0U) {
@@ -134,7 +134,7 @@ int socketcan_host_send(int fd, const struct socketcan_host_frame *frame)
 	}
 	cf.len = frame->dlc;
 	if ((frame->flags & SOCKETCAN_HOST_F_RTR) == 0U) {
-		memcpy(cf.data, frame->data, frame->dlc);
+		(void)memcpy(cf.data, frame->data, frame->dlc);
 	}
 
 	n = send(fd, &cf, sizeof(cf), MSG_DONTWAIT);
@@ -150,7 +150,7 @@ uint64_t socketcan_host_mono_ns(void)
 {
 	struct timespec ts;
 
-	clock_gettime(CLOCK_MONOTONIC, &ts);
+	(void)clock_gettime(CLOCK_MONOTONIC, &ts);
 
 	return (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
 }
@@ -159,7 +159,7 @@ uint64_t socketcan_host_real_ns(void)
 {
 	struct timespec ts;
 
-	clock_gettime(CLOCK_REALTIME, &ts);
+	(void)clock_gettime(CLOCK_REALTIME, &ts);
 
 	return (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
 }
@@ -208,19 +208,19 @@ int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx
 		if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
 			struct timespec ts;
 
-			memcpy(&ts, CMSG_DATA(c), sizeof(ts));
+			(void)memcpy(&ts, CMSG_DATA(c), sizeof(ts));
 			*rx_real_ns = (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
 			*rx_mono_ns = realtime_to_mono_ns(*rx_real_ns);
 		}
 	}
 	*own = (msg.msg_flags & MSG_CONFIRM) != 0;
 
-	memset(frame, 0, sizeof(*frame));
+	(void)memset(frame, 0, sizeof(*frame));
 	frame->dlc = cf.len > 8U ? 8U : cf.len;
 	if ((cf.can_id & CAN_ERR_FLAG) != 0U) {
 		frame->flags = SOCKETCAN_HOST_F_ERR;
 		frame->id = cf.can_id & CAN_ERR_MASK;
-		memcpy(frame->data, cf.data, sizeof(frame->data));
+		(void)memcpy(frame->data, cf.data, sizeof(frame->data));
 		return 0;
 	}
 	if ((cf.can_id & CAN_EFF_FLAG) != 0U) {
@@ -232,7 +232,7 @@ int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx
 	if ((cf.can_id & CAN_RTR_FLAG) != 0U) {
 		frame->flags |= SOCKETCAN_HOST_F_RTR;
 	} else {
-		memcpy(frame->data, cf.data, frame->dlc);
+		(void)memcpy(frame->data, cf.data, frame->dlc);
 	}
 
 	return 0;
@@ -243,7 +243,7 @@ void socketcan_host_decode_error(const struct socketcan_host_frame *frame,
 {
 	const uint8_t ctrl = frame->data[1];
 
-	memset(err, 0, sizeof(*err));
+	(void)memset(err, 0, sizeof(*err));
 	err->state = SOCKETCAN_HOST_STATE_NONE;
 
 	/* The most severe piece of news wins: bus-off, then passive, then warning. */
@@ -258,6 +258,9 @@ void socketcan_host_decode_error(const struct socketcan_host_frame *frame,
 	} else if ((frame->id & CAN_ERR_RESTARTED) != 0U ||
 		   ((frame->id & CAN_ERR_CRTL) != 0U && (ctrl & CAN_ERR_CRTL_ACTIVE) != 0U)) {
 		err->state = SOCKETCAN_HOST_STATE_ACTIVE;
+	} else {
+		/* Other error frames (lost arbitration, protocol errors ...) leave the state as it
+		 * is. */
 	}
 
 	if ((frame->id & CAN_ERR_CNT) != 0U) {
@@ -271,7 +274,7 @@ int socketcan_host_send_state(int fd, enum socketcan_host_state state)
 {
 	struct can_frame cf;
 
-	memset(&cf, 0, sizeof(cf));
+	(void)memset(&cf, 0, sizeof(cf));
 	cf.len = CAN_ERR_DLC;
 	switch (state) {
 	case SOCKETCAN_HOST_STATE_ACTIVE:

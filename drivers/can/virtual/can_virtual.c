@@ -515,14 +515,14 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 	uint64_t t = cv_next_event_locked(bus, &ev, &arg);
 
 	if (ev == CV_EV_NONE || t > now) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return false;
 	}
 
 	switch (ev) {
 	case CV_EV_START:
 		cv_start_frame_locked(bus, t);
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return true;
 
 	case CV_EV_RECOVER: {
@@ -532,7 +532,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 		d->recover_at_ns = CV_NEVER;
 		cv_set_state_locked(d, CAN_STATE_ERROR_ACTIVE, 0U, 0U, &n);
 		k_sem_give(&d->recovered);
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		LOG_DBG("%s: bus-off recovery done", d->dev->name);
 		cv_notify_run(&n);
 		return true;
@@ -545,7 +545,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 		const bool ok = cv_can_receive_locked(d) && d->bus == bus;
 
 		e->used = false;
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		if (ok) {
 			cv_deliver(d, &frame);
 		}
@@ -572,7 +572,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 		(*frames)++;
 
 		if ((frame.flags & CAN_FRAME_RTR) != 0U) {
-			memset(frame.data, 0, sizeof(frame.data));
+			(void)memset(frame.data, 0, sizeof(frame.data));
 		}
 		if (!loopback) {
 			lost = !cv_apply_faults_locked(b, &frame, &delay_ns);
@@ -598,7 +598,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 				}
 			}
 		}
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 
 		cv_stamp(&frame, t);
 		for (int i = 0; i < n_rx; i++) {
@@ -609,7 +609,7 @@ static bool cv_run_event(uint8_t bus, uint64_t now, int *frames)
 	}
 
 	default:
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return false;
 	}
 }
@@ -626,16 +626,16 @@ static void cv_bus_thread(void *p1, void *p2, void *p3)
 		int arg;
 		uint64_t next;
 
-		k_mutex_lock(&cv_lock, K_FOREVER);
+		(void)k_mutex_lock(&cv_lock, K_FOREVER);
 		if (cv_run_event(bus, cv_now_ns(), &frames)) {
 			continue;
 		}
-		k_mutex_lock(&cv_lock, K_FOREVER);
+		(void)k_mutex_lock(&cv_lock, K_FOREVER);
 		next = cv_next_event_locked(bus, &ev, &arg);
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		/* Sleep until the next event; a new frame or state change gives the kick. */
 		if (next == CV_NEVER) {
-			k_sem_take(&b->kick, K_FOREVER);
+			(void)k_sem_take(&b->kick, K_FOREVER);
 		} else {
 			k_sem_take(&b->kick, K_TIMEOUT_ABS_TICKS(k_ns_to_ticks_ceil64(next)));
 		}
@@ -658,7 +658,7 @@ static int cv_start(const struct device *dev)
 	struct cv_data *d = cv_data(dev);
 	int rc = 0;
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EALREADY;
 	} else {
@@ -670,7 +670,7 @@ static int cv_start(const struct device *dev)
 		d->cut_hit = false;
 		d->common.started = true;
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return rc;
 }
@@ -681,16 +681,16 @@ static int cv_stop(const struct device *dev)
 	struct cv_txdone aborted[CV_TXQ_SIZE];
 	int n;
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (!d->common.started) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return -EALREADY;
 	}
 	d->common.started = false;
 	d->recover_at_ns = CV_NEVER;
 	n = cv_abort_tx_locked(d, -ENETDOWN, aborted);
 	cv_kick(d->bus);
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	cv_txdone_run(dev, aborted, n);
 
 	return 0;
@@ -701,7 +701,7 @@ static int cv_set_mode(const struct device *dev, can_mode_t mode)
 	struct cv_data *d = cv_data(dev);
 	int rc = 0;
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EBUSY;
 	} else if ((mode & ~(can_mode_t)CV_CAPABILITIES) != 0U) {
@@ -709,7 +709,7 @@ static int cv_set_mode(const struct device *dev, can_mode_t mode)
 	} else {
 		d->common.mode = mode;
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return rc;
 }
@@ -719,13 +719,13 @@ static int cv_set_bitrate(const struct device *dev, uint32_t bitrate)
 	struct cv_data *d = cv_data(dev);
 	int rc = 0;
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EBUSY;
 	} else {
 		d->bitrate = bitrate;
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return rc;
 }
@@ -741,15 +741,17 @@ static int cv_send(const struct device *dev, const struct can_frame *frame, k_ti
 		return -ENOTSUP;
 	}
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (!d->common.started) {
 		rc = -ENETDOWN;
 	} else if (d->state == CAN_STATE_BUS_OFF) {
 		rc = -ENETUNREACH;
 	} else if ((d->common.mode & CAN_MODE_LISTENONLY) != 0U) {
 		rc = -EIO;
+	} else {
+		/* Started, not bus-off, not listen-only: the frame is sent below. */
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	if (rc != 0) {
 		return rc;
 	}
@@ -758,16 +760,18 @@ static int cv_send(const struct device *dev, const struct can_frame *frame, k_ti
 		return -EAGAIN;
 	}
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	/* The controller may have stopped or gone bus-off while we waited. */
 	if (!d->common.started) {
 		rc = -ENETDOWN;
 	} else if (d->state == CAN_STATE_BUS_OFF) {
 		rc = -ENETUNREACH;
+	} else {
+		/* Still started and not bus-off: the frame is queued below. */
 	}
 	if (rc != 0) {
 		k_sem_give(&d->tx_slots);
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return rc;
 	}
 	for (int i = 0; i < CV_TXQ_SIZE; i++) {
@@ -792,7 +796,7 @@ static int cv_send(const struct device *dev, const struct can_frame *frame, k_ti
 		}
 	}
 	cv_kick(d->bus);
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	cv_notify_run(&n);
 
 	return 0;
@@ -819,14 +823,14 @@ static int cv_get_state(const struct device *dev, enum can_state *state,
 {
 	struct cv_data *d = cv_data(dev);
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (state != NULL) {
 		*state = d->common.started ? d->state : CAN_STATE_STOPPED;
 	}
 	if (err_cnt != NULL) {
 		*err_cnt = cv_err_cnt(d);
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return 0;
 }
@@ -835,22 +839,22 @@ static int cv_recover(const struct device *dev, k_timeout_t timeout)
 {
 	struct cv_data *d = cv_data(dev);
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if ((d->common.mode & CAN_MODE_MANUAL_RECOVERY) == 0U) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return -ENOTSUP;
 	}
 	if (!d->common.started) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return -ENETDOWN;
 	}
 	if (d->state != CAN_STATE_BUS_OFF) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return 0;
 	}
 	k_sem_reset(&d->recovered);
 	cv_schedule_recovery_locked(d);
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return k_sem_take(&d->recovered, timeout) == 0 ? 0 : -EAGAIN;
 }
@@ -860,10 +864,10 @@ static void cv_set_state_change_callback(const struct device *dev,
 {
 	struct cv_data *d = cv_data(dev);
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	d->common.state_change_cb = callback;
 	d->common.state_change_cb_user_data = user_data;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 }
 
 static int cv_get_max_filters(const struct device *dev, bool ide)
@@ -902,7 +906,7 @@ static int cv_add_fault(int bus, enum cv_fault_type type, const struct can_filte
 	if (!cv_bus_ok(bus) || filter == NULL || count == 0U) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	for (int i = 0; i < CV_MAX_FAULTS; i++) {
 		struct cv_fault *f = &cv_buses[bus].faults[i];
 
@@ -910,16 +914,16 @@ static int cv_add_fault(int bus, enum cv_fault_type type, const struct can_filte
 			f->type = type;
 			f->filter = *filter;
 			f->remaining = count;
-			memset(f->xor_mask, 0, sizeof(f->xor_mask));
+			(void)memset(f->xor_mask, 0, sizeof(f->xor_mask));
 			if (xor_mask != NULL) {
-				memcpy(f->xor_mask, xor_mask, sizeof(f->xor_mask));
+				(void)memcpy(f->xor_mask, xor_mask, sizeof(f->xor_mask));
 			}
 			f->delay_us = delay_us;
 			rc = 0;
 			break;
 		}
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return rc;
 }
@@ -954,11 +958,11 @@ int can_virtual_clear_faults(int bus)
 	if (!cv_bus_ok(bus)) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	for (int i = 0; i < CV_MAX_FAULTS; i++) {
 		cv_buses[bus].faults[i].type = CV_FAULT_NONE;
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return 0;
 }
@@ -980,9 +984,9 @@ int can_virtual_set_state(const struct device *dev, enum can_state state)
 		return -EINVAL;
 	}
 	d = cv_data(dev);
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (!d->common.started) {
-		k_mutex_unlock(&cv_lock);
+		(void)k_mutex_unlock(&cv_lock);
 		return -ENETDOWN;
 	}
 	const bool was_bus_off = d->state == CAN_STATE_BUS_OFF;
@@ -997,9 +1001,11 @@ int can_virtual_set_state(const struct device *dev, enum can_state state)
 		/* Leaving bus-off by injection ends a running recovery too. */
 		d->recover_at_ns = CV_NEVER;
 		k_sem_give(&d->recovered);
+	} else {
+		/* Between the active, warning and passive states nothing more changes. */
 	}
 	cv_kick(d->bus);
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	cv_notify_run(&n);
 	cv_txdone_run(dev, aborted, n_aborted);
 
@@ -1015,7 +1021,7 @@ int can_virtual_cut(const struct device *dev)
 		return -EINVAL;
 	}
 	d = cv_data(dev);
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (!d->cut) {
 		bool pending = false;
 
@@ -1035,7 +1041,7 @@ int can_virtual_cut(const struct device *dev)
 			}
 		}
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	cv_notify_run(&n);
 
 	return 0;
@@ -1050,7 +1056,7 @@ int can_virtual_restore(const struct device *dev)
 		return -EINVAL;
 	}
 	d = cv_data(dev);
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (d->cut) {
 		d->cut = false;
 		if (d->cut_hit && d->state == CAN_STATE_ERROR_PASSIVE) {
@@ -1059,7 +1065,7 @@ int can_virtual_restore(const struct device *dev)
 		d->cut_hit = false;
 		cv_kick(d->bus);
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 	cv_notify_run(&n);
 
 	return 0;
@@ -1070,9 +1076,9 @@ int can_virtual_set_latency(const struct device *dev, uint32_t latency_us)
 	if (!cv_is_ours(dev)) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	cv_data(dev)->latency_us = latency_us;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return 0;
 }
@@ -1086,13 +1092,13 @@ int can_virtual_set_bus(const struct device *dev, int bus)
 		return -EINVAL;
 	}
 	d = cv_data(dev);
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	if (d->common.started) {
 		rc = -EBUSY;
 	} else {
 		d->bus = (uint8_t)bus;
 	}
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return rc;
 }
@@ -1104,9 +1110,9 @@ int can_virtual_get_bus(const struct device *dev)
 	if (!cv_is_ours(dev)) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	bus = cv_data(dev)->bus;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return bus;
 }
@@ -1116,9 +1122,9 @@ int can_virtual_bus_set_bit_timing(int bus, bool enable)
 	if (!cv_bus_ok(bus)) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	cv_buses[bus].bit_timing = enable;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return 0;
 }
@@ -1128,9 +1134,9 @@ int can_virtual_bus_get_stats(int bus, struct can_virtual_bus_stats *stats)
 	if (!cv_bus_ok(bus) || stats == NULL) {
 		return -EINVAL;
 	}
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	*stats = cv_buses[bus].stats;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return 0;
 }
@@ -1139,9 +1145,9 @@ uint64_t can_virtual_time_us(void)
 {
 	uint64_t t;
 
-	k_mutex_lock(&cv_lock, K_FOREVER);
+	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	t = cv_now_ns() / 1000U;
-	k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&cv_lock);
 
 	return t;
 }
@@ -1261,11 +1267,11 @@ static int cv_buses_init(void)
 
 		b->bit_timing = IS_ENABLED(CONFIG_CAN_VIRTUAL_BIT_TIMING);
 #if defined(CONFIG_CAN_VIRTUAL_CLOCK_REALTIME)
-		k_sem_init(&b->kick, 0, 1);
+		(void)k_sem_init(&b->kick, 0, 1);
 		k_thread_create(&b->thread, cv_stacks[bus], K_THREAD_STACK_SIZEOF(cv_stacks[bus]),
 				cv_bus_thread, (void *)(uintptr_t)bus, NULL, NULL,
 				CONFIG_CAN_VIRTUAL_THREAD_PRIORITY, 0, K_NO_WAIT);
-		k_thread_name_set(&b->thread, "can_virtual_bus");
+		(void)k_thread_name_set(&b->thread, "can_virtual_bus");
 #endif
 	}
 
@@ -1286,9 +1292,9 @@ static int cv_init(const struct device *dev)
 	d->state = CAN_STATE_ERROR_ACTIVE;
 	d->recover_at_ns = CV_NEVER;
 	d->common.mode = CAN_MODE_NORMAL;
-	k_mutex_init(&d->rx_lock);
-	k_sem_init(&d->tx_slots, CV_TXQ_SIZE, CV_TXQ_SIZE);
-	k_sem_init(&d->recovered, 0, 1);
+	(void)k_mutex_init(&d->rx_lock);
+	(void)k_sem_init(&d->tx_slots, CV_TXQ_SIZE, CV_TXQ_SIZE);
+	(void)k_sem_init(&d->recovered, 0, 1);
 	cv_devs[cfg->index] = dev;
 
 	return 0;

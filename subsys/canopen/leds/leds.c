@@ -173,13 +173,15 @@ static void update(struct co_node *node)
 
 static void hb_event(struct co_leds *l, uint8_t id, enum co_hb_event ev)
 {
-	uint32_t bit = BIT(id % 32U);
+	uint32_t bit = 1U << (id % 32U);
 	uint32_t *word = &l->hb_lost[(id / 32U) % ARRAY_SIZE(l->hb_lost)];
 
 	if (ev == CO_HB_EV_LOST) {
 		*word |= bit;
 	} else if (ev == CO_HB_EV_RECOVERED || ev == CO_HB_EV_BOOTUP || ev == CO_HB_EV_STARTED) {
 		*word &= ~bit;
+	} else {
+		/* A state change of a running consumer does not change its lost flag. */
 	}
 }
 
@@ -200,6 +202,8 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 			l->rpdo_timeout = (ev->error.flags & CO_ERROR_F_ACTIVE) != 0U;
 		} else if (ev->error.code == CO_EMCY_SYNC_LENGTH) {
 			l->sync_error = (ev->error.flags & CO_ERROR_F_ACTIVE) != 0U;
+		} else {
+			/* Other errors have no LED pattern of their own. */
 		}
 		break;
 	case CO_EV_EMCY:
@@ -221,7 +225,7 @@ static int node_event(struct co_node *node, const struct co_event *ev, void *use
 		break;
 	case CO_EV_NMT_RESET:
 		/* A reset drops the stack's own errors; the controller's state stays. */
-		memset(l->hb_lost, 0, sizeof(l->hb_lost));
+		(void)memset(l->hb_lost, 0, sizeof(l->hb_lost));
 		l->life_lost = false;
 		l->rpdo_timeout = false;
 		l->sync_error = false;
@@ -238,7 +242,7 @@ static int leds_init(struct co_node *node)
 {
 	struct co_leds *l = &node->leds;
 
-	memset(l, 0, sizeof(*l));
+	(void)memset(l, 0, sizeof(*l));
 	co_timer_init(&l->timer, tick, &node->lock, node);
 	co_listener_init(&l->listener, "leds",
 			 CO_EV_BIT(CO_EV_NMT_STATE) | CO_EV_BIT(CO_EV_NMT_RESET) |

@@ -76,6 +76,8 @@ static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
 			      CO_ERROR_F_ACTIVE | CO_ERROR_F_BEHAVIOUR);
 	} else if (!active) {
 		co_node_error(node, CO_EMCY_HEARTBEAT, CO_EMCY_REG_COMMUNICATION, remote_id, 0U);
+	} else {
+		/* Another consumer still misses its heartbeat: the error stays active. */
 	}
 }
 
@@ -196,6 +198,8 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		comm_error(e->node, e->remote_id, false);
 	} else if (prev != state) {
 		hbc_report(e, CO_HB_EV_STATE);
+	} else {
+		/* The same state again: no event. */
 	}
 }
 

@@ -93,7 +93,7 @@ static int srv_send(struct co_sdo_srv *srv, const uint8_t d[CO_SDO_DLC])
 {
 	struct can_frame f;
 
-	memset(&f, 0, sizeof(f));
+	(void)memset(&f, 0, sizeof(f));
 	if ((srv->cob_tx & CO_SDO_COBID_FRAME) != 0U) {
 		f.id = srv->cob_tx & EFF_MASK;
 		f.flags = CAN_FRAME_IDE;
@@ -101,7 +101,7 @@ static int srv_send(struct co_sdo_srv *srv, const uint8_t d[CO_SDO_DLC])
 		f.id = srv->cob_tx & SFF_MASK;
 	}
 	f.dlc = CO_SDO_DLC;
-	memcpy(f.data, d, CO_SDO_DLC);
+	(void)memcpy(f.data, d, CO_SDO_DLC);
 	return co_node_send(srv->node, srv->route, &f);
 }
 
@@ -207,7 +207,7 @@ static uint32_t dn_put(struct co_sdo_srv *srv, const uint8_t *p, uint32_t len)
 		srv->done += srv->buf_len;
 		srv->buf_len = 0U;
 	}
-	memcpy(&srv->buf[srv->buf_len], p, len);
+	(void)memcpy(&srv->buf[srv->buf_len], p, len);
 	srv->buf_len += len;
 	return CO_SDO_AB_NONE;
 }
@@ -376,7 +376,7 @@ static uint32_t up_respond(struct co_sdo_srv *srv)
 		r[0] = CO_SDO_B0(CO_SDO_SCS_UP_INIT,
 				 CO_SDO_INIT_E | CO_SDO_INIT_S |
 					 CO_SDO_INIT_N_PUT(CO_SDO_EXP_SIZE - srv->size));
-		memcpy(&r[4], srv->buf, srv->size);
+		(void)memcpy(&r[4], srv->buf, srv->size);
 		(void)srv_send(srv, r);
 		srv_complete(srv);
 		return CO_SDO_AB_NONE;
@@ -420,7 +420,7 @@ static uint32_t up_segment(struct co_sdo_srv *srv, const uint8_t *d)
 	last = srv->offset + len >= srv->size;
 	r[0] = CO_SDO_B0(CO_SDO_SCS_UP_SEG,
 			 t | CO_SDO_SEG_N_PUT(CO_SDO_SEG_SIZE - len) | (last ? CO_SDO_SEG_C : 0U));
-	memcpy(&r[1], &srv->buf[srv->offset - srv->buf_off], len);
+	(void)memcpy(&r[1], &srv->buf[srv->offset - srv->buf_off], len);
 	srv->offset += len;
 	(void)srv_send(srv, r);
 	if (last) {
@@ -497,7 +497,7 @@ static uint32_t blk_dn_segment(struct co_sdo_srv *srv, const uint8_t *d, uint64_
 	if (seqno == srv->seq + 1U) {
 		if (last) {
 			/* Its length is only known from the end request. */
-			memcpy(srv->tail, &d[1], sizeof(srv->tail));
+			(void)memcpy(srv->tail, &d[1], sizeof(srv->tail));
 			got_last = true;
 		} else {
 			uint32_t code;
@@ -526,6 +526,8 @@ static uint32_t blk_dn_segment(struct co_sdo_srv *srv, const uint8_t *d, uint64_
 		}
 	} else if (SUB_TIMEOUT_US != 0U) {
 		srv->sub_deadline = now + SUB_TIMEOUT_US;
+	} else {
+		/* No sub-block timeout configured: the whole-transfer timeout applies. */
 	}
 	return CO_SDO_AB_NONE;
 }
@@ -597,7 +599,7 @@ static uint32_t blk_up_send(struct co_sdo_srv *srv, uint64_t now)
 			return code;
 		}
 		r[0] = i | (last ? CO_SDO_BLK_SEG_C : 0U);
-		memcpy(&r[1], &srv->buf[o - srv->buf_off], len);
+		(void)memcpy(&r[1], &srv->buf[o - srv->buf_off], len);
 		/* Pause before the line's TX queue overflows rather than lose a frame to it. */
 		err = co_node_tx_space(srv->node, srv->route) > 0 ? srv_send(srv, r) : -ENOBUFS;
 		if (err == -ENOBUFS) {
@@ -823,6 +825,8 @@ static void srv_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		srv->deadline = now_us + TIMEOUT_US;
 		srv->tx_waits = 0U;
 		srv_arm(srv);
+	} else {
+		/* The transfer ended with this answer: no timer to arm. */
 	}
 	srv->in_rx = false;
 	/* A write to this server's own COB-IDs takes effect after its answer went out. */
@@ -997,7 +1001,7 @@ int co_sdo_srv_init(struct co_sdo_srv *srv, struct co_node *node, uint8_t num)
 	if (srv == NULL || node == NULL || num >= CONFIG_CANOPEN_SDO_SERVERS) {
 		return -EINVAL;
 	}
-	memset(srv, 0, sizeof(*srv));
+	(void)memset(srv, 0, sizeof(*srv));
 	srv->node = node;
 	srv->num = num;
 	srv->cob_rx = CO_SDO_COBID_INVALID;
@@ -1087,17 +1091,17 @@ struct co_sdo_srv *co_sdo_srv_get(struct co_node *node, uint8_t num)
 
 void co_sdo_srv_get_stats(struct co_sdo_srv *srv, struct co_sdo_srv_stats *stats)
 {
-	k_mutex_lock(&srv->node->lock, K_FOREVER);
+	(void)k_mutex_lock(&srv->node->lock, K_FOREVER);
 	*stats = srv->stats;
-	k_mutex_unlock(&srv->node->lock);
+	(void)k_mutex_unlock(&srv->node->lock);
 }
 
 bool co_sdo_srv_busy(struct co_sdo_srv *srv)
 {
 	bool busy;
 
-	k_mutex_lock(&srv->node->lock, K_FOREVER);
+	(void)k_mutex_lock(&srv->node->lock, K_FOREVER);
 	busy = srv->state != ST_IDLE;
-	k_mutex_unlock(&srv->node->lock);
+	(void)k_mutex_unlock(&srv->node->lock);
 	return busy;
 }

@@ -168,6 +168,9 @@ static void fail(struct co_srdo_inst *in, uint8_t reason, uint64_t time_us)
 		report(in->node, CO_EMCY_PDO_LENGTH, in->number, 0U);
 	} else if (reason != CO_SRDO_R_TX_FAIL) {
 		report(in->node, CO_EMCY_SRDO_PROTOCOL, in->number, reason);
+	} else {
+		/* TX_FAIL: a pair the line could not take; only the state and its reason record it.
+		 */
 	}
 	set_reason(in, reason, time_us);
 	LOG_WRN("%s: SRDO %u safe state (reason %u)", in->node->name, in->number, reason);
@@ -244,7 +247,7 @@ static uint8_t ent_resolve(const struct co_od *od, uint32_t entry, bool rx, stru
 	uint8_t sub = (uint8_t)(entry >> 8);
 	uint8_t bits = (uint8_t)entry;
 
-	memset(e, 0, sizeof(*e));
+	(void)memset(e, 0, sizeof(*e));
 	if (co_od_find(od, index, sub, &e->info) != 0U) {
 		return CO_SRDO_CFG_NO_OBJECT;
 	}
@@ -479,7 +482,7 @@ static void rx_normal(struct co_rx *rx, const struct can_frame *frame, uint64_t 
 		fail(in, CO_SRDO_R_SHORT, now_us);
 		return;
 	}
-	memcpy(in->normal, frame->data, in->len);
+	(void)memcpy(in->normal, frame->data, in->len);
 	in->expect_inverted = true;
 	in->srvt_deadline = now_us + in->srvt_us;
 	consumer_arm(in);
@@ -819,7 +822,7 @@ static int srdo_init(struct co_node *node)
 		},
 	};
 
-	memset(s, 0, sizeof(*s));
+	(void)memset(s, 0, sizeof(*s));
 	for (uint8_t n = 1; n <= CO_SRDO_MAX; n++) {
 		if (co_od_find(&node->od, comm_idx(n), 0, &info) != 0U) {
 			continue;

@@ -297,7 +297,7 @@ static int write_image(struct co_storage *st, uint32_t save_mask, uint32_t drop_
 	/* 3. Header, sync, then the commit mark. */
 	uint8_t hdr[12];
 
-	memcpy(hdr, sl, sizeof(sl));
+	(void)memcpy(hdr, sl, sizeof(sl));
 	co_od_le_put(hdr + 8, 4, w.crc ^ 0xFFFFFFFFU);
 	err = st->be->api->write(st->be, w.base + 4U, hdr, sizeof(hdr));
 	if (err == 0) {
@@ -477,7 +477,7 @@ int co_storage_init(struct co_storage *st, struct co_od *od, const struct co_sto
 	if (st == NULL || od == NULL || be == NULL || be->api == NULL) {
 		return -EINVAL;
 	}
-	memset(st, 0, sizeof(*st));
+	(void)memset(st, 0, sizeof(*st));
 	st->od = od;
 	st->be = be;
 	st->slot_size = be->api->size(be) / 2U;

@@ -22,7 +22,7 @@ static int ram_read(const struct co_storage_backend *be, uint32_t offset, void *
 	if (offset > r->size || len > r->size - offset) {
 		return -EINVAL;
 	}
-	memcpy(buf, r->mem + offset, len);
+	(void)memcpy(buf, r->mem + offset, len);
 	return 0;
 }
 
@@ -34,7 +34,7 @@ static int ram_write(const struct co_storage_backend *be, uint32_t offset, const
 	if (offset > r->size || len > r->size - offset) {
 		return -ENOSPC;
 	}
-	memcpy(r->mem + offset, buf, len);
+	(void)memcpy(r->mem + offset, buf, len);
 	return 0;
 }
 

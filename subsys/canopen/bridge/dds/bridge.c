@@ -890,8 +890,9 @@ static void refresh(void)
 
 		co_line_get_stats(l->line, &st);
 		read_can_state(l);
+		/* Byte images compared and copied whole: co_line_get_stats() zeroes the padding. */
 		if (memcmp(&st, &l->stats, sizeof(st)) != 0) {
-			l->stats = st;
+			(void)memcpy(&l->stats, &st, sizeof(st));
 			l->dirty = true;
 		}
 		if (l->dirty) {
@@ -1027,7 +1028,6 @@ static int create_entities(const struct co_bridge_dds_config *cfg)
 	char uri[600];
 	const char *conf = loopback_xml;
 	dds_qos_t *q;
-	dds_entity_t e[10];
 	int err = 0;
 
 	if (cfg->dds_config != NULL) {
@@ -1062,21 +1062,24 @@ static int create_entities(const struct co_bridge_dds_config *cfg)
 	}
 
 	q = qos_state(1);
-	e[0] = br.wr_bridge = writer(&safeline_canopen_v1_BridgeState_desc, TOPIC_BRIDGE, q);
-	e[1] = br.wr_line = writer(&safeline_canopen_v1_LineState_desc, TOPIC_LINE, q);
-	e[2] = br.wr_node = writer(&safeline_canopen_v1_NodeState_desc, TOPIC_NODE, q);
-	e[3] = br.wr_srdo = writer(&safeline_canopen_v1_SrdoState_desc, TOPIC_SRDO, q);
-	e[4] = br.wr_value = writer(&safeline_canopen_v1_OdValue_desc, TOPIC_VALUE, q);
+	br.wr_bridge = writer(&safeline_canopen_v1_BridgeState_desc, TOPIC_BRIDGE, q);
+	br.wr_line = writer(&safeline_canopen_v1_LineState_desc, TOPIC_LINE, q);
+	br.wr_node = writer(&safeline_canopen_v1_NodeState_desc, TOPIC_NODE, q);
+	br.wr_srdo = writer(&safeline_canopen_v1_SrdoState_desc, TOPIC_SRDO, q);
+	br.wr_value = writer(&safeline_canopen_v1_OdValue_desc, TOPIC_VALUE, q);
 	dds_delete_qos(q);
 	q = qos_state(EMCY_HISTORY);
-	e[5] = br.wr_emcy = writer(&safeline_canopen_v1_Emcy_desc, TOPIC_EMCY, q);
+	br.wr_emcy = writer(&safeline_canopen_v1_Emcy_desc, TOPIC_EMCY, q);
 	dds_delete_qos(q);
 	q = qos_rpc();
-	e[6] = br.rd_sdo = reader(&safeline_canopen_v1_SdoRequest_desc, TOPIC_SDO_RQ, q);
-	e[7] = br.wr_sdo = writer(&safeline_canopen_v1_SdoReply_desc, TOPIC_SDO_RP, q);
-	e[8] = br.rd_nmt = reader(&safeline_canopen_v1_NmtRequest_desc, TOPIC_NMT_RQ, q);
-	e[9] = br.wr_nmt = writer(&safeline_canopen_v1_NmtReply_desc, TOPIC_NMT_RP, q);
+	br.rd_sdo = reader(&safeline_canopen_v1_SdoRequest_desc, TOPIC_SDO_RQ, q);
+	br.wr_sdo = writer(&safeline_canopen_v1_SdoReply_desc, TOPIC_SDO_RP, q);
+	br.rd_nmt = reader(&safeline_canopen_v1_NmtRequest_desc, TOPIC_NMT_RQ, q);
+	br.wr_nmt = writer(&safeline_canopen_v1_NmtReply_desc, TOPIC_NMT_RP, q);
 	dds_delete_qos(q);
+	const dds_entity_t e[] = {br.wr_bridge, br.wr_line, br.wr_node, br.wr_srdo, br.wr_value,
+				  br.wr_emcy,   br.rd_sdo,  br.wr_sdo,  br.rd_nmt,  br.wr_nmt};
+
 	for (size_t i = 0; i < ARRAY_SIZE(e); i++) {
 		if (e[i] < 0) {
 			LOG_ERR("DDS endpoint %zu: %s", i, dds_strretcode(e[i]));

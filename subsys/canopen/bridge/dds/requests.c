@@ -63,7 +63,7 @@ static int requester_present(dds_entity_t rd, dds_entity_t wr, dds_instance_hand
 	dds_instance_handle_t subs[64];
 	dds_builtintopic_endpoint_t *w = dds_get_matched_publication_data(rd, pub);
 	int32_t n;
-	int found = 0;
+	bool found = false;
 
 	if (w == NULL) {
 		return -1;
@@ -79,7 +79,7 @@ static int requester_present(dds_entity_t rd, dds_entity_t wr, dds_instance_hand
 		}
 	}
 	dds_builtintopic_free_endpoint(w);
-	return found;
+	return found ? 1 : 0;
 }
 
 static bool requester_ready(dds_entity_t rd, dds_entity_t wr, dds_instance_handle_t pub)
