@@ -266,6 +266,10 @@ static void print_network(int i)
 			n += (size_t)snprintf(&list[n], sizeof(list) - n, " %u", slave_id[s]);
 		}
 	}
+	if ((opt.nodes >> N_MGR) == 0U) {
+		printk("manager node %u: NMT startup done (no slave in this process)\n", mgr_id[i]);
+		return;
+	}
 	printk("manager node %u: NMT startup done, slaves%s Operational\n", mgr_id[i], list);
 }
 
