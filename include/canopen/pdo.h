@@ -134,7 +134,9 @@ struct co_pdo_map_ent {
 struct co_pdo_map {
 	struct co_pdo_map_ent ent[CO_PDO_MAP_ENTRIES];
 	/* co_od.hook_gen when every entry was found a plain copy, 0 if not (pdo_internal.h) */
+#if CO_OD_COVER
 	uint32_t fast_gen;
+#endif
 	uint8_t n;     /* entries in use */
 	uint8_t bits;  /* total mapped length, 0..64 */
 	bool bytewise; /* every entry is a whole number of bytes */

@@ -169,7 +169,9 @@ static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n
 		out->n = 0U;
 		out->bits = 0U;
 		out->bytewise = true;
+#if CO_OD_COVER
 		out->fast_gen = 0U;
+#endif
 	}
 	if (n > CO_PDO_MAP_ENTRIES) {
 		return CO_SDO_AB_MAP_LEN;

@@ -37,6 +37,15 @@
 #define CO_PDO_ENT_COVER(ent) ((struct co_od_cover *)NULL)
 #endif
 
+/* Whether the copy-only path holds for @p map at hook generation @p gen (never without the
+ * cache: the mapping then has no mark).
+ */
+#if CO_OD_COVER
+#define CO_PDO_MAP_FAST(map, gen) ((map)->fast_gen == (gen))
+#else
+#define CO_PDO_MAP_FAST(map, gen) false
+#endif
+
 /* Largest data field of a classic CAN frame, in bits. */
 #define CO_PDO_MAX_BITS 64U
 
@@ -124,7 +133,7 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
 					     uint8_t data[8])
 {
-	if (CO_OD_COVER && likely(map->fast_gen == od->hook_gen)) {
+	if (likely(CO_PDO_MAP_FAST(map, od->hook_gen))) {
 		uint8_t frame[8] = {0};
 		unsigned int off = 0;
 
@@ -149,7 +158,7 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 {
 	uint32_t gen = od->hook_gen;
 
-	if (CO_OD_COVER && likely(map->fast_gen == gen)) {
+	if (likely(CO_PDO_MAP_FAST(map, gen))) {
 		unsigned int off = 0;
 
 		for (uint8_t i = 0; i < map->n; i++) {

@@ -162,6 +162,7 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 	return co_od_write_cached(od, &ent->info, CO_PDO_ENT_COVER(ent), buf, size, writer);
 }
 
+#if CO_OD_COVER
 /* Whether every entry of a mapping is a plain copy now (see pdo_internal.h). */
 static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool rx)
 {
@@ -181,6 +182,21 @@ static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool
 	}
 	return true;
 }
+
+/* Mark a mapping for the copy-only path when every entry is a plain copy now. */
+static void map_mark(const struct co_od *od, struct co_pdo_map *map, bool rx)
+{
+	map->fast_gen = map_plain(od, map, rx) ? od->hook_gen : 0U;
+}
+#else
+/* Without the cache no mapping is marked. */
+static inline void map_mark(const struct co_od *od, struct co_pdo_map *map, bool rx)
+{
+	(void)od;
+	(void)map;
+	(void)rx;
+}
+#endif
 
 /*
  * Without bit-wise mapping co_pdo_map_check() lets through whole objects in whole bytes and
@@ -216,7 +232,7 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 		}
 		off += co_pdo_ent_bits(ent);
 	}
-	map->fast_gen = map_plain(od, map, false) ? od->hook_gen : 0U;
+	map_mark(od, map, false);
 	return (uint8_t)((map->bits + 7U) / 8U);
 }
 
@@ -246,6 +262,6 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 		}
 		off += map->bytewise ? co_pdo_ent_bits(ent) / 8U : co_pdo_ent_bits(ent);
 	}
-	map->fast_gen = map_plain(od, map, true) ? od->hook_gen : 0U;
+	map_mark(od, map, true);
 	return refused;
 }
