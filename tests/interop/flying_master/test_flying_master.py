@@ -7,7 +7,8 @@ wins and boots the network; then process A is killed (SIGKILL: no frame more fro
 Node 2 loses node 3's heartbeat, resets the network, negotiates alone and boots the slaves
 again. The test checks the 071h-076h frames and their layouts, the new master's NMT commands,
 the slaves Operational again, and what the python slave saw; it prints the take-over time
-against the bound of 1F90h's timings.
+against the bound of 1F90h's timings. A second test runs the five nodes in one process on vcan,
+where the sample's own kill stops node 3's SocketCAN controller.
 """
 
 import threading
@@ -216,3 +217,32 @@ def test_active_master_killed_other_takes_over(image, iface, network, bus_log):
     cyc = [f.timestamp for f in after if f.arbitration_id == 0x076 and f.timestamp > won.timestamp]
     assert cyc, "076h cycle of the new master"
     assert 4020 - 100 <= (cyc[0] - won.timestamp) * 1e3 <= 4020 + SLACK_MS
+
+
+def test_one_process_kill_stops_the_controller(image, iface, network, bus_log):
+    """All five nodes in one process on vcan: the sample's own kill stops node 3's SocketCAN
+    controller (can_stop()); node 3 is silent on the bus from then on and node 2 takes over."""
+    mgr_eds = regenerated_eds("fm_manager")
+    d = Device(image, iface, network, mgr_eds, 3, "flying_master: nodes", TIMINGS)
+    try:
+        d.start()
+        assert wait_for(lambda: said(d, "flying_master: done"), 60), out(d)
+        frames = list(bus_log)
+    finally:
+        d.stop()
+    text = "".join(d.lines)
+    for line in ("flying_master: nodes 3 2 10 11 12 on " + iface,
+                 "manager node 3: NMT startup done, slaves 10 11 12 Operational",
+                 "killing the active master (node 3)",
+                 "node 2: active master node 3 lost: Reset Communication, negotiation",
+                 "node 2: active master (priority 1)",
+                 f"(bound {BOUND_MS} ms from the last heartbeat)",
+                 "manager node 2: NMT startup done, slaves 10 11 12 Operational"):
+        assert line in text, text
+    won = first(frames, lambda f: f.arbitration_id == 0x071 and bytes(f.data) == b"\x01\x02")
+    assert won is not None
+    hb3 = [f.timestamp for f in frames if f.arbitration_id == 0x703]
+    assert hb3 and hb3[-1] < won.timestamp - CONSUMER_MS / 1e3, "node 3 silent after the kill"
+    for n in (10, 11, 12):
+        hb = [f for f in frames if f.arbitration_id == 0x700 + n]
+        assert hb and hb[-1].data[0] == 0x05, f"node {n} Operational at the end"
