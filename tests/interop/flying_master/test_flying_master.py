@@ -17,7 +17,7 @@ import time
 import can
 import canopen
 
-from safeline_interop import SDO_TIMEOUT, Device, regenerated_eds
+from safeline_interop import Device, regenerated_eds
 
 # Slower than the sample's defaults (heartbeat 100 ms, consumer 300 ms): inside the VM an image
 # can be starved for 0.6 s on a loaded host, and a late heartbeat would be a real loss.
