@@ -324,6 +324,7 @@ struct co_mgr_fm {
 	uint8_t master_id;
 	uint8_t master_prio;
 	uint8_t ev_master; /* the master the last CO_EV_FM named (no repeats after resets) */
+	uint8_t forced_id; /* lower-priority master we forced (302 §5.5.2: once), or 0 */
 	bool warm;         /* the last reset was a Reset Communication */
 	bool seen_072;     /* a 072h came since this negotiation round began */
 	bool bus_off;      /* our controller is (was) bus-off: restart the round on recovery */

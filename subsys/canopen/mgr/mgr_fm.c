@@ -265,7 +265,17 @@ static uint8_t a_071(struct co_mgr *m, const struct fm_ev_data *ev)
 		 */
 		return become_slave(m, ev->prio, ev->id);
 	}
+	if (ev->id == m->fm.forced_id) {
+		/*
+		 * It won the negotiation our 076h forced: its timing parameters beat our priority.
+		 * Forcing again would only loop (CiA 302 §5.5.2): it stays the master.
+		 */
+		LOG_WRN("%s: lower-priority node %u won again: not forcing (check 1F90h timings)",
+			m->node->name, ev->id);
+		return become_slave(m, ev->prio, ev->id);
+	}
 	/* A lower-priority master: make it renegotiate (302-2 §3.7 g). */
+	m->fm.forced_id = ev->id;
 	co_timer_stop(&m->fm.timer);
 	m->fm.master_id = ev->id;
 	m->fm.master_prio = ev->prio;
@@ -283,6 +293,7 @@ static uint8_t a_win(struct co_mgr *m, const struct fm_ev_data *ev)
 	ARG_UNUSED(ev);
 	m->fm.master_id = m->node->node_id;
 	m->fm.master_prio = own_prio(m);
+	m->fm.forced_id = 0U;
 	m->fm.wins++;
 	send(m, COB_MASTER_ID, 2, m->fm.master_prio, m->fm.master_id);
 	co_node_timer_start(m->node, &m->fm.cycle, co_mgr_now(m) + MS_US(fm_obj(m, FT_CYCLE)));
@@ -328,6 +339,7 @@ static uint8_t a_lost(struct co_mgr *m, const struct fm_ev_data *ev)
 	ARG_UNUSED(ev);
 	LOG_WRN("%s: active master %u lost: taking over", m->node->name, m->fm.master_id);
 	m->fm.ev_master = 0U;
+	m->fm.forced_id = 0U;
 	publish(m, CO_MGR_FM_EV_LOST);
 	/* 076h cannot help: no master is left to act on it. */
 	reset_all(m);

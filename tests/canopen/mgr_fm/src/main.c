@@ -580,6 +580,42 @@ ZTEST(co_mgr_fm, test_lower_priority_071_during_negotiation_forces)
 	zassert_equal(count(0x071, 0, 0), 0);
 }
 
+/*
+ * CiA 302 §5.5.2: a lower-priority node that wins the negotiation we forced (its timing
+ * parameters beat our priority) stays the master: one 076h, not a loop of them.
+ */
+ZTEST(co_mgr_fm, test_lower_priority_winner_is_forced_once)
+{
+	int first;
+
+	candidate(0, 5, 0);
+	start_all();
+	run_ms(1220);
+	inject(0x071, 2, 0x02, 0x0A);
+	first = find(0x076, 0, 1200 * MS);
+	zassert_true(first >= 0, "the first 076h");
+	zassert_equal(fm(0).state, CO_MGR_FM_FORCED);
+	/*
+	 * Node 0Ah resets the network and wins the new round before our slot again (warm: our
+	 * 073h 500 ms after the reset, a 072h would come at 600 and our W is 50 ms).
+	 */
+	inject(0x000, 2, 0x82, 0x00);
+	run_ms(560);
+	zassert_equal(fm(0).state, CO_MGR_FM_DETECT);
+	inject(0x072, 0, 0, 0);
+	run_ms(10);
+	inject(0x071, 2, 0x02, 0x0A);
+	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
+	zassert_equal(fm(0).master_id, 0x0A);
+	for (int i = 0; i < 5; i++) {
+		inject(0x70A, 1, 0x05, 0);
+		run_ms(100);
+	}
+	zassert_equal(count(0x076, first + 1, 0), 0, "no second 076h");
+	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
+	zassert_equal(n_ev(0, CO_MGR_FM_EV_FORCE), 1);
+}
+
 /* 302 §5.3: 076h is for the active master only; every other state ignores it. */
 ZTEST(co_mgr_fm, test_076_ignored_unless_active_master)
 {
