@@ -173,7 +173,7 @@ static void update(struct co_node *node)
 
 static void hb_event(struct co_leds *l, uint8_t id, enum co_hb_event ev)
 {
-	uint32_t bit = 1U << (id % 32U);
+	uint32_t bit = BIT(id % 32U);
 	uint32_t *word = &l->hb_lost[(id / 32U) % ARRAY_SIZE(l->hb_lost)];
 
 	if (ev == CO_HB_EV_LOST) {
