@@ -258,7 +258,8 @@ struct co_line {
 	const struct k_mutex *txq_origin[CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE];
 	uint16_t tx_head;
 	uint16_t tx_count;
-	uint16_t tx_inflight;
+	/* Frames handed to the driver whose TX completion has not run yet (co_line_stop()). */
+	atomic_t tx_inflight;
 
 	co_line_sink_t sink;
 	void *sink_user_data;

@@ -23,6 +23,9 @@
 
 LOG_MODULE_DECLARE(co_line, CONFIG_CANOPEN_LOG_LEVEL);
 
+/* How long co_line_stop() waits for the TX completions of frames the controller holds. */
+#define CO_LINE_STOP_TX_WAIT_MS 100
+
 struct co_line *co_line_current(void)
 {
 #if defined(CONFIG_THREAD_CUSTOM_DATA)
@@ -110,6 +113,8 @@ static void line_tx_cb(const struct device *dev, int error, void *user_data)
 	if (error != 0 || atomic_test_bit(&line->flags, CO_LINE_F_TX_WAITING)) {
 		co_line_wake(line);
 	}
+	/* The last access to the line: once the count is zero co_line_stop() may return. */
+	(void)atomic_dec(&line->tx_inflight);
 }
 
 static void line_state_cb(const struct device *dev, enum can_state state,
@@ -127,7 +132,24 @@ static void line_state_cb(const struct device *dev, enum can_state state,
 
 int co_line_dev_send(struct co_line *line, const struct can_frame *frame)
 {
-	return can_send(line->dev, frame, K_NO_WAIT, line_tx_cb, line);
+	int err;
+
+	/*
+	 * Counted before the stop flag is read, and co_line_stop() sets the flag before it reads
+	 * the count (both sequentially consistent): either this send sees the flag and the frame
+	 * waits in the TX queue, or co_line_stop() sees the count and waits for the callback.
+	 */
+	(void)atomic_inc(&line->tx_inflight);
+	if (atomic_test_bit(&line->flags, CO_LINE_F_STOP)) {
+		err = -EAGAIN;
+	} else {
+		err = can_send(line->dev, frame, K_NO_WAIT, line_tx_cb, line);
+	}
+	if (err != 0) {
+		/* Refused: the driver does not call back (Zephyr's can_send() contract). */
+		(void)atomic_dec(&line->tx_inflight);
+	}
+	return err;
 }
 
 static void line_report_async(struct co_line *line)
@@ -184,16 +206,22 @@ static void line_thread(void *p1, void *p2, void *p3)
 #endif
 	while (!atomic_test_bit(&line->flags, CO_LINE_F_STOP)) {
 		/*
-		 * Frames that arrived before now are handled before the deadlines due by now: a
-		 * thread that wakes late must not call a frame that came in time (an SRDO's
-		 * inverted frame, a heartbeat) missing because its timer ran first.
+		 * A frame is judged by when it was received: frames queued before a deadline are
+		 * handled before that deadline's timer runs. So "now" is read before the queue is
+		 * drained and the timers run only up to it: every frame queued by then, which
+		 * includes every frame received before a deadline that is due, is dispatched first
+		 * (SRDO's inverted frame, a heartbeat, an RPDO before its SCT/SRVT/event timer),
+		 * however late the thread runs and however long the reports below take. Frames
+		 * queued later are after "now", so after any deadline run in this pass.
 		 */
+		uint64_t now = co_line_now();
+
 		if (k_msgq_get(&line->rxq, &msg, K_NO_WAIT) == 0) {
 			line_drain(line, &msg);
 		}
 		line_report_async(line);
 
-		uint64_t next = co_line_process(line, co_line_now());
+		uint64_t next = co_line_process(line, now);
 		k_timeout_t timeout = K_FOREVER;
 
 		if (next != UINT64_MAX) {
@@ -252,22 +280,60 @@ fail:
 	return err;
 }
 
+/* Wait up to @p ms for the TX completions of the frames the driver holds; true when none is left.
+ */
+static bool line_tx_settled(struct co_line *line, int ms)
+{
+	for (int i = 0; atomic_get(&line->tx_inflight) != 0; i++) {
+		if (i >= ms) {
+			return false;
+		}
+		k_msleep(1);
+	}
+	return true;
+}
+
 int co_line_stop(struct co_line *line)
 {
 	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
 
 	if (!atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
+		/* Stopped, but a TX completion was still due: ask again. */
+		if (line->dev != NULL && atomic_get(&line->tx_inflight) != 0) {
+			return line_tx_settled(line, CO_LINE_STOP_TX_WAIT_MS) ? 0 : -EBUSY;
+		}
 		return -EALREADY;
 	}
+	/* From here on sends queue in the line (co_line_dev_send()) instead of the driver. */
 	atomic_set_bit(&line->flags, CO_LINE_F_STOP);
 	(void)k_msgq_put(&line->rxq, &msg, K_NO_WAIT);
 	k_thread_join(&line->thread, K_FOREVER);
 
+	/* No receive or state callback runs once these return (the driver's contract). */
 	can_remove_rx_filter(line->dev, line->filter_std);
 	can_remove_rx_filter(line->dev, line->filter_ext);
 	can_set_state_change_callback(line->dev, NULL, NULL);
 	line->filter_std = -1;
 	line->filter_ext = -1;
+
+	/*
+	 * TX completions come from the driver's own context (the virtual bus's thread, the
+	 * SocketCAN receive thread) and may still be due for frames handed over before the
+	 * flag was set. Wait for them: frames on a working bus end within milliseconds. A bus
+	 * that does not take them (no acknowledgement) gets the controller stopped, which
+	 * aborts them (-ENETDOWN) on drivers that can; a frame even that cannot recall
+	 * (SocketCAN: the kernel holds it) leaves -EBUSY.
+	 */
+	int err = 0;
+
+	if (!line_tx_settled(line, CO_LINE_STOP_TX_WAIT_MS)) {
+		LOG_WRN("%s: %d frames still in the controller; stopping it", line->name,
+			(int)atomic_get(&line->tx_inflight));
+		(void)can_stop(line->dev);
+		if (!line_tx_settled(line, CO_LINE_STOP_TX_WAIT_MS)) {
+			err = -EBUSY;
+		}
+	}
 	atomic_clear_bit(&line->flags, CO_LINE_F_RUNNING);
-	return 0;
+	return err;
 }
