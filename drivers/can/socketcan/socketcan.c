@@ -26,7 +26,9 @@
  * Locking: lock guards started, state, the in-flight FIFO and the receive gate; rx_lock is
  * held while receive callbacks run, while filters change and across the "started and fresh?"
  * decision for a frame and its delivery, so that no receive callback runs once can_stop() has
- * returned. Order: rx_lock before lock. No callback runs with lock held.
+ * returned; it is also held while the state-change callback runs and while it is replaced, so
+ * a replaced callback never runs afterwards. Order: rx_lock before lock. No callback runs with
+ * lock held.
  */
 
 #include <errno.h>
@@ -402,10 +404,16 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 
 	socketcan_host_decode_error(hf, &err);
 
+	/*
+	 * rx_lock from the callback's read to its end: once can_set_state_change_callback()
+	 * has returned, the callback it replaced never runs.
+	 */
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
 	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	if (!sc_rx_fresh_locked(d, rx_real_ns)) {
 		/* news from before the last can_start(), which reset the state */
 		(void)k_mutex_unlock(&d->lock);
+		(void)k_mutex_unlock(&d->rx_lock);
 		return;
 	}
 	if (err.has_counters) {
@@ -450,6 +458,7 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 	if (cb != NULL) {
 		cb(d->dev, state, cnt, cb_data);
 	}
+	(void)k_mutex_unlock(&d->rx_lock);
 }
 
 static void sc_rx_thread(void *p1, void *p2, void *p3)
@@ -759,10 +768,13 @@ static void sc_set_state_change_callback(const struct device *dev,
 {
 	struct sc_data *d = sc_data(dev);
 
+	/* Also under rx_lock: waits for a notification under way (sc_on_error_frame()). */
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
 	(void)k_mutex_lock(&d->lock, K_FOREVER);
 	d->common.state_change_cb = callback;
 	d->common.state_change_cb_user_data = user_data;
 	(void)k_mutex_unlock(&d->lock);
+	(void)k_mutex_unlock(&d->rx_lock);
 }
 
 static int sc_get_max_filters(const struct device *dev, bool ide)

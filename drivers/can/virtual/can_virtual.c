@@ -16,7 +16,8 @@
  *
  * Locking: one mutex (cv_lock) guards all bus and controller state; it is never held while a
  * callback runs. Each controller's rx_lock is held while its receive callbacks run and while
- * its filters change, so a removed filter is never called afterwards. Callbacks must not block
+ * its filters change, so a removed filter is never called afterwards; state_cb_lock does the
+ * same for the state-change callback. Callbacks must not block
  * (Zephyr's ISR rule); they may call the CAN API (k_mutex is recursive).
  */
 
@@ -89,6 +90,8 @@ struct cv_data {
 	struct k_sem tx_slots;
 	/* given when a bus-off ends, for can_recover() */
 	struct k_sem recovered;
+	/* Held while a state-change callback runs and while it is replaced (before cv_lock). */
+	struct k_mutex state_cb_lock;
 	/* guarded by rx_lock */
 	struct k_mutex rx_lock;
 	struct can_filter_slot filters[CV_MAX_FILTERS];
@@ -237,10 +240,21 @@ static void cv_set_state_locked(struct cv_data *d, enum can_state state, uint16_
 	}
 }
 
+/*
+ * Called under the controller's state_cb_lock with the callback read again there, so that once
+ * can_set_state_change_callback() has returned the callback it replaced never runs.
+ */
 static void cv_notify_run(const struct cv_notify *n)
 {
 	if (n->dev != NULL && n->cb != NULL) {
-		n->cb(n->dev, n->state, n->cnt, n->user_data);
+		struct cv_data *d = cv_data(n->dev);
+
+		(void)k_mutex_lock(&d->state_cb_lock, K_FOREVER);
+		if (d->common.state_change_cb != NULL) {
+			d->common.state_change_cb(n->dev, n->state, n->cnt,
+						  d->common.state_change_cb_user_data);
+		}
+		(void)k_mutex_unlock(&d->state_cb_lock);
 	}
 }
 
@@ -864,10 +878,13 @@ static void cv_set_state_change_callback(const struct device *dev,
 {
 	struct cv_data *d = cv_data(dev);
 
+	/* Also under state_cb_lock: waits for a notification under way (cv_notify_run()). */
+	(void)k_mutex_lock(&d->state_cb_lock, K_FOREVER);
 	(void)k_mutex_lock(&cv_lock, K_FOREVER);
 	d->common.state_change_cb = callback;
 	d->common.state_change_cb_user_data = user_data;
 	(void)k_mutex_unlock(&cv_lock);
+	(void)k_mutex_unlock(&d->state_cb_lock);
 }
 
 static int cv_get_max_filters(const struct device *dev, bool ide)
@@ -1293,6 +1310,7 @@ static int cv_init(const struct device *dev)
 	d->recover_at_ns = CV_NEVER;
 	d->common.mode = CAN_MODE_NORMAL;
 	(void)k_mutex_init(&d->rx_lock);
+	(void)k_mutex_init(&d->state_cb_lock);
 	(void)k_sem_init(&d->tx_slots, CV_TXQ_SIZE, CV_TXQ_SIZE);
 	(void)k_sem_init(&d->recovered, 0, 1);
 	cv_devs[cfg->index] = dev;
