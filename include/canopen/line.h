@@ -344,9 +344,14 @@ int co_line_start(struct co_line *line, k_thread_stack_t *stack, size_t stack_si
 /**
  * @brief Stop the line thread and remove the CAN filters. Waits for the thread to end.
  *
- * Must not be called from the line thread.
+ * Returns 0 only when no callback of the line (receive, state change, TX completion) can run
+ * any more: the line may then be re-initialised or freed. Waits for the TX completions of the
+ * frames the driver holds; after 100 ms it stops the controller (can_stop()) to abort them.
+ * Frames sent meanwhile wait in the line's TX queue. Must not be called from the line thread.
  *
  * @retval 0 Stopped.
+ * @retval -EBUSY Stopped, but the driver still holds frames it could not abort: their
+ *         completions will still reach the line; keep it untouched and call again until 0.
  * @retval -EALREADY The line was not running.
  */
 int co_line_stop(struct co_line *line);
