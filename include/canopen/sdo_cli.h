@@ -92,7 +92,7 @@ struct co_sdo_cli_stats {
 	uint32_t aborts_rcvd;     /**< Aborts received from the server. */
 	uint32_t dropped;         /**< Transfers ended by NMT or reconfiguration (no frame). */
 	uint32_t rx_malformed;    /**< Frames ignored: DLC != 8 or remote. */
-	uint32_t rx_stray;        /**< Frames ignored: no transfer running. */
+	uint32_t rx_stray;        /**< Frames ignored: no transfer running, or a late answer. */
 	uint32_t blk_seg_ignored; /**< Block upload segments ignored (gap, duplicate). */
 	uint32_t tx_retries;      /**< Block download segments held back by a full TX queue. */
 	uint32_t last_abort;      /**< Last abort code sent or received. */

@@ -598,6 +598,27 @@ static uint32_t cli_dispatch(struct co_sdo_cli *cli, const uint8_t *d, uint64_t 
 	}
 }
 
+/*
+ * A late answer to a transfer this client already ended (a timeout, an abort): it names
+ * another object in bytes 1-3. Only frames that carry the multiplexer count: anything while
+ * an initiate response is awaited, and server aborts (one naming object 0000h:00h is
+ * taken, as a server that cannot tell the object may send it). Aborting the running
+ * transfer for it would leave every later transfer one answer behind.
+ */
+static bool late_answer(const struct co_sdo_cli *cli, const uint8_t *d)
+{
+	bool init = cli->state == ST_DN_INIT || cli->state == ST_UP_INIT ||
+		    cli->state == ST_BLK_DN_INIT || cli->state == ST_BLK_UP_INIT;
+
+	if (mux_matches(cli, d)) {
+		return false;
+	}
+	if (d[0] == CO_SDO_B0(CO_SDO_CS_ABORT, 0U)) {
+		return (sys_get_le16(&d[1]) != 0U) || (d[3] != 0U);
+	}
+	return init;
+}
+
 static void cli_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
 {
 	struct co_sdo_cli *cli = rx->user_data;
@@ -609,7 +630,7 @@ static void cli_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		cli->stats.rx_malformed++;
 		return;
 	}
-	if (!running(cli)) {
+	if (!running(cli) || late_answer(cli, d)) {
 		cli->stats.rx_stray++;
 		return;
 	}

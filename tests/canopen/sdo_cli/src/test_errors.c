@@ -200,12 +200,12 @@ ZTEST(sdo_cli_errors, test_abort_05040001_wrong_command_specifier)
 	h_expect_abort(0x2000, 0, CO_SDO_AB_CMD);
 	expect_con(CO_SDO_AB_CMD);
 
-	/* An upload response naming another object. */
+	/* A download response to a download of the same object, when an upload is awaited. */
 	memset(rec(), 0, sizeof(*rec()));
-	start_ul(0x2000, 0, 4, CO_SDO_CLI_AUTO, 0);
+	start_ul(0x2005, 0, 100, CO_SDO_CLI_AUTO, 0);
 	h_skip_all();
-	h_fake(0x43, 0x2001, 0, 1);
-	h_expect_abort(0x2000, 0, CO_SDO_AB_CMD);
+	h_fake(0x60, 0x2005, 0, 0);
+	h_expect_abort(0x2005, 0, CO_SDO_AB_CMD);
 	expect_con(CO_SDO_AB_CMD);
 
 	/* An upload segment in a segmented download. */
@@ -224,6 +224,53 @@ ZTEST(sdo_cli_errors, test_abort_05040001_wrong_command_specifier)
 	h_fake(0xA4, 0x2005, 0, 127);
 	h_expect_abort(0x2005, 0, CO_SDO_AB_CMD);
 	expect_con(CO_SDO_AB_CMD);
+}
+
+/*
+ * The answer to a transfer that timed out comes after the next request: it names another
+ * object and is ignored; the next transfer gets its own answer (it used to abort with
+ * 05040001h, and each later transfer then got the answer of the one before).
+ */
+ZTEST(sdo_cli_errors, test_late_answer_of_an_ended_transfer_is_ignored)
+{
+	struct co_sdo_cli_stats st;
+
+	start_ul(0x2000, 0, 4, CO_SDO_CLI_AUTO, 0);
+	h_expect(0x40, 0x2000, 0, 0);
+	h_advance(TIMEOUT_US);
+	h_expect_abort(0x2000, 0, CO_SDO_AB_TIMEOUT);
+	expect_con(CO_SDO_AB_TIMEOUT);
+
+	/* A download: the upload's answer, then the server's abort of it, come first. */
+	memset(rec(), 0, sizeof(*rec()));
+	start_dl(0x2001, 0, 4, CO_SDO_CLI_AUTO);
+	h_skip_all();
+	h_fake(0x43, 0x2000, 0, 0x11223344);
+	h_fake(0x80, 0x2000, 0, CO_SDO_AB_TIMEOUT);
+	h_expect_none();
+	zassert_equal(rec()->calls, 0U);
+	h_fake(0x60, 0x2001, 0, 0);
+	expect_con(0);
+
+	/* An upload: a late download response of another object is ignored too. */
+	memset(rec(), 0, sizeof(*rec()));
+	start_ul(0x2000, 0, 4, CO_SDO_CLI_AUTO, 0);
+	h_expect(0x40, 0x2000, 0, 0);
+	h_fake(0x60, 0x2001, 0, 0);
+	h_expect_none();
+	h_fake(0x43, 0x2000, 0, 0x04030201);
+	expect_con(0);
+	zassert_equal(sys_get_le32(buf), 0x04030201);
+
+	/* An abort naming no object still ends the transfer. */
+	memset(rec(), 0, sizeof(*rec()));
+	start_ul(0x2000, 0, 4, CO_SDO_CLI_AUTO, 0);
+	h_skip_all();
+	h_fake(0x80, 0x0000, 0, CO_SDO_AB_NO_OBJECT);
+	expect_con(CO_SDO_AB_NO_OBJECT);
+
+	co_sdo_cli_get_stats(h_cli(C), &st);
+	zassert_equal(st.rx_stray, 3U);
 }
 
 ZTEST(sdo_cli_errors, test_malformed_and_stray_frames_are_ignored)
