@@ -77,7 +77,7 @@ static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
 	} else if (!active) {
 		co_node_error(node, CO_EMCY_HEARTBEAT, CO_EMCY_REG_COMMUNICATION, remote_id, 0U);
 	} else {
-		/* Another consumer still misses its heartbeat: the error stays active. */
+		/* A heartbeat or the life guard is still lost: the error stays active. */
 	}
 }
 
