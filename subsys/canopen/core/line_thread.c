@@ -280,17 +280,16 @@ fail:
 	return err;
 }
 
-/* Wait up to @p ms for the TX completions of the frames the driver holds; true when none is left.
- */
+/* Wait up to @p ms for the TX completions of the frames the driver holds; true if none is left. */
 static bool line_tx_settled(struct co_line *line, int ms)
 {
-	for (int i = 0; atomic_get(&line->tx_inflight) != 0; i++) {
-		if (i >= ms) {
-			return false;
-		}
+	int waited = 0;
+
+	while (atomic_get(&line->tx_inflight) != 0 && waited < ms) {
 		k_msleep(1);
+		waited++;
 	}
-	return true;
+	return atomic_get(&line->tx_inflight) == 0;
 }
 
 int co_line_stop(struct co_line *line)
