@@ -22,6 +22,8 @@
 #include <canopen/node.h>
 #include <canopen/storage.h>
 
+#include "co_bus.h"
+
 #include "lss_test_od.h"
 
 #define MASTER_ID 0x01
@@ -37,7 +39,6 @@
 
 static struct {
 	struct co_line line;
-	uint64_t now;
 	/* Frames the line sent: count per kind, and the last few. */
 	uint32_t n_req;  /* 7E5h */
 	uint32_t n_ans;  /* 7E4h */
@@ -60,8 +61,12 @@ static struct {
 	bool chain;
 } t;
 
-static int sink(struct co_line *line, const struct can_frame *f, void *user_data)
+/* Counts what the line sends (injected frames are not counted). */
+static void tap(const struct can_frame *f, int from)
 {
+	if (from == CO_BUS_INJECTED) {
+		return;
+	}
 	if (f->id == CO_LSS_MASTER_COB_ID) {
 		t.req = *f;
 		t.n_req++;
@@ -70,28 +75,6 @@ static int sink(struct co_line *line, const struct can_frame *f, void *user_data
 	} else if (f->id > 0x700 && f->id <= 0x77F && f->dlc == 1 && f->data[0] == 0) {
 		t.n_boot++;
 	}
-	return 0;
-}
-
-/* Advance to @p at, running every deadline and every queued frame on the way. */
-static void run_until(uint64_t at)
-{
-	while (true) {
-		uint64_t next = co_line_next_deadline(&t.line);
-
-		if (next == UINT64_MAX || next > at) {
-			break;
-		}
-		t.now = MAX(next, t.now);
-		co_line_process(&t.line, t.now);
-	}
-	t.now = at;
-	co_line_process(&t.line, t.now);
-}
-
-static void run_ms(uint64_t ms)
-{
-	run_until(t.now + ms * MS);
 }
 
 static void con(struct co_node *node, int err, const struct co_lss_master_result *res,
@@ -102,7 +85,7 @@ static void con(struct co_node *node, int err, const struct co_lss_master_result
 	t.n_con++;
 	t.err = err;
 	t.res = *res;
-	t.con_at = t.now;
+	t.con_at = bus.now;
 	if (t.chain) {
 		t.chain = false;
 		/* A confirmation may start the next request. */
@@ -114,7 +97,10 @@ static void con(struct co_node *node, int err, const struct co_lss_master_result
 static void boot(int n, bool configured)
 {
 	memset(&t, 0, sizeof(t));
-	co_line_init_sim(&t.line, "sim", sink, NULL);
+	co_bus_init();
+	co_bus_attach(0, &t.line, "sim");
+	bus.tap = tap;
+	bus.no_log = true;
 	zassert_ok(co_node_init(&t.master, "master", &t.line, &lss_test_od_def, &t.master_ram,
 				MASTER_ID));
 	for (int i = 0; i < n; i++) {
@@ -133,7 +119,7 @@ static void boot(int n, bool configured)
 		co_node_unlock(&t.slave[i]);
 	}
 	zassert_ok(co_node_start(&t.master));
-	run_ms(1);
+	co_bus_run_ms(1);
 	t.n_req = t.n_ans = t.n_boot = 0;
 }
 
@@ -156,8 +142,7 @@ static void inject_answer(uint8_t dlc, uint8_t cs, uint8_t b1, uint8_t b2)
 	f.dlc = dlc;
 	f.data[1] = b1;
 	f.data[2] = b2;
-	co_line_rx(&t.line, &f, t.now);
-	co_line_process(&t.line, t.now);
+	co_bus_inject(&f);
 }
 
 static struct co_lss_address address_of(int i)
@@ -173,7 +158,7 @@ ZTEST(co_lss_master, test_switch_global_moves_every_slave)
 {
 	boot(2, true);
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_CONFIGURATION));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_req, 1);
 	zassert_equal(t.req.data[0], 0x04);
 	zassert_equal(t.req.data[1], 0x01);
@@ -181,7 +166,7 @@ ZTEST(co_lss_master, test_switch_global_moves_every_slave)
 	zassert_equal(co_lss_get_state(&t.slave[0]), CO_LSS_STATE_CONFIGURATION);
 	zassert_equal(co_lss_get_state(&t.slave[1]), CO_LSS_STATE_CONFIGURATION);
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_WAITING));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(co_lss_get_state(&t.slave[1]), CO_LSS_STATE_WAITING);
 	zassert_equal(co_lss_master_switch_global(&t.master, 2), -EINVAL);
 	zassert_equal(t.n_con, 0, "nothing to confirm");
@@ -191,7 +176,7 @@ ZTEST(co_lss_master, test_activate_bit_timing_frame)
 {
 	boot(0, true);
 	zassert_ok(co_lss_master_activate_bit_timing(&t.master, 0x1234));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_req, 1);
 	zassert_mem_equal(t.req.data, ((uint8_t[8]){0x15, 0x34, 0x12}), 8);
 }
@@ -206,7 +191,7 @@ ZTEST(co_lss_master, test_switch_selective_selects_one_slave)
 	a = address_of(1);
 	zassert_ok(co_lss_master_switch_selective_req(&t.master, &a, 0, con, &t));
 	zassert_equal(co_lss_master_switch_selective_req(&t.master, &a, 0, con, &t), -EBUSY);
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_req, 4, "40h, 41h, 42h, 43h");
 	zassert_equal(t.n_con, 1);
 	zassert_ok(t.err);
@@ -224,17 +209,17 @@ ZTEST(co_lss_master, test_switch_selective_without_answer_times_out)
 	a = address_of(0);
 	a.part[3] = 0xDEAD;
 	zassert_ok(co_lss_master_switch_selective_req(&t.master, &a, 0, con, &t));
-	run_ms(TIMEOUT - 1);
+	co_bus_run_ms(TIMEOUT - 1);
 	zassert_equal(t.n_con, 0, "still waiting");
-	run_ms(2);
+	co_bus_run_ms(2);
 	zassert_equal(t.n_con, 1);
 	zassert_equal(t.err, -ETIMEDOUT);
 	zassert_equal(t.con_at, (uint64_t)TIMEOUT * MS + 1 * MS, "after exactly the timeout");
 	/* A timeout of the request's own. */
 	zassert_ok(co_lss_master_switch_selective_req(&t.master, &a, 7, con, &t));
-	run_ms(6);
+	co_bus_run_ms(6);
 	zassert_equal(t.n_con, 1);
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_con, 2);
 	zassert_equal(t.err, -ETIMEDOUT);
 }
@@ -255,7 +240,7 @@ ZTEST(co_lss_master, test_config_node_id_store_and_inquire)
 		static const uint32_t expect[] = {VENDOR, PRODUCT, REVISION, 0x100, 0xFF};
 
 		zassert_ok(co_lss_master_inquire_req(&t.master, cs, 0, con, &t));
-		run_ms(1);
+		co_bus_run_ms(1);
 		zassert_ok(t.err);
 		zassert_equal(t.res.cs, cs);
 		zassert_equal(t.res.value, expect[cs - CO_LSS_CS_INQUIRE_VENDOR], "cs %02x", cs);
@@ -266,19 +251,19 @@ ZTEST(co_lss_master, test_config_node_id_store_and_inquire)
 	zassert_equal(co_lss_master_config_node_id_req(&t.master, 0, 0, con, &t), -EINVAL);
 	zassert_equal(co_lss_master_config_node_id_req(&t.master, 0x80, 0, con, &t), -EINVAL);
 	zassert_ok(co_lss_master_config_node_id_req(&t.master, 0x0A, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_ok(t.err);
 	zassert_equal(t.res.lss_err, CO_LSS_ERR_OK);
 	zassert_equal(co_node_pending_id(&t.slave[0]), 0x0A);
 
 	zassert_ok(co_lss_master_store_req(&t.master, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_ok(t.err);
 	zassert_equal(t.res.cs, CO_LSS_CS_STORE);
 
 	/* Back to waiting: the slave boots with its new node-ID. */
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_WAITING));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(co_node_id(&t.slave[0]), 0x0A);
 	zassert_equal(t.n_boot, 1);
 }
@@ -289,12 +274,12 @@ ZTEST(co_lss_master, test_slave_error_codes_are_confirmed_as_eremoteio)
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_CONFIGURATION));
 	/* No medium attached: storing not supported. */
 	zassert_ok(co_lss_master_store_req(&t.master, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.err, -EREMOTEIO);
 	zassert_equal(t.res.lss_err, CO_LSS_ERR_STORE_SUPPORTED);
 	/* A simulation line has no controller: bit timing not supported. */
 	zassert_ok(co_lss_master_config_bit_timing_req(&t.master, 0, 2, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.err, -EREMOTEIO);
 	zassert_equal(t.res.cs, CO_LSS_CS_CONFIG_BIT_TIMING);
 	zassert_equal(t.res.lss_err, CO_LSS_ERR_BIT_TIMING);
@@ -308,17 +293,17 @@ ZTEST(co_lss_master, test_identify_remote_counts_answers_in_range)
 	boot(4, true);
 	zassert_ok(co_lss_master_identify_remote_req(&t.master, VENDOR, PRODUCT, 0, UINT32_MAX,
 						     0x101, 0x102, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_req, 6, "46h..4Bh");
 	zassert_equal(t.n_con, 0, "waits the whole timeout: any number may answer");
-	run_ms(TIMEOUT);
+	co_bus_run_ms(TIMEOUT);
 	zassert_equal(t.n_con, 1);
 	zassert_ok(t.err);
 	zassert_equal(t.res.answers, 2, "serials 101h and 102h");
 
 	zassert_ok(co_lss_master_identify_remote_req(&t.master, VENDOR, PRODUCT + 1, 0, UINT32_MAX,
 						     0, UINT32_MAX, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ENODEV);
 	zassert_equal(co_lss_master_identify_remote_req(&t.master, VENDOR, PRODUCT, 2, 1, 0, 1, 0,
 							con, &t),
@@ -329,13 +314,13 @@ ZTEST(co_lss_master, test_identify_non_configured)
 {
 	boot(3, false);
 	zassert_ok(co_lss_master_identify_non_configured_req(&t.master, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_ok(t.err);
 	zassert_equal(t.res.answers, 3);
 
 	boot(3, true);
 	zassert_ok(co_lss_master_identify_non_configured_req(&t.master, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ENODEV);
 	zassert_equal(t.res.answers, 0);
 }
@@ -346,16 +331,16 @@ ZTEST(co_lss_master, test_every_answered_request_times_out_without_answer)
 {
 	boot(1, true); /* the slave stays in waiting: it answers none of these */
 	zassert_ok(co_lss_master_config_node_id_req(&t.master, 5, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ETIMEDOUT);
 	zassert_ok(co_lss_master_config_bit_timing_req(&t.master, 0, 0, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ETIMEDOUT);
 	zassert_ok(co_lss_master_store_req(&t.master, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ETIMEDOUT);
 	zassert_ok(co_lss_master_inquire_req(&t.master, CO_LSS_CS_INQUIRE_SERIAL, 0, con, &t));
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.err, -ETIMEDOUT);
 	zassert_equal(t.n_con, 4);
 	{
@@ -373,7 +358,7 @@ ZTEST(co_lss_master, test_wrong_answers_are_ignored)
 
 	boot(0, true);
 	zassert_ok(co_lss_master_config_node_id_req(&t.master, 5, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	inject_answer(7, CO_LSS_CS_CONFIG_NODE_ID, 0, 0);  /* DLC 7 */
 	inject_answer(8, CO_LSS_CS_STORE, 0, 0);           /* another request's answer */
 	inject_answer(8, CO_LSS_CS_INQUIRE_NODE_ID, 5, 0); /* another request's answer */
@@ -400,13 +385,13 @@ ZTEST(co_lss_master, test_cancel_reset_and_chained_request)
 	zassert_ok(co_lss_master_cancel(&t.master));
 	zassert_equal(t.n_con, 1, "confirmed at once");
 	zassert_equal(t.err, -ECANCELED);
-	run_ms(TIMEOUT + 1);
+	co_bus_run_ms(TIMEOUT + 1);
 	zassert_equal(t.n_con, 1, "and only once");
 
 	/* A reset of the master's node ends the request. */
 	zassert_ok(co_lss_master_store_req(&t.master, 0, con, &t));
 	zassert_ok(co_nmt_req(&t.master, CO_NMT_CS_RESET_COMMUNICATION));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_con, 2);
 	zassert_equal(t.err, -ECANCELED);
 
@@ -414,7 +399,7 @@ ZTEST(co_lss_master, test_cancel_reset_and_chained_request)
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_CONFIGURATION));
 	t.chain = true;
 	zassert_ok(co_lss_master_inquire_req(&t.master, CO_LSS_CS_INQUIRE_VENDOR, 0, con, &t));
-	run_ms(1);
+	co_bus_run_ms(1);
 	zassert_equal(t.n_con, 4);
 	zassert_ok(t.err);
 	zassert_equal(t.res.cs, CO_LSS_CS_INQUIRE_NODE_ID);
@@ -430,7 +415,7 @@ static int fastscan(const struct co_lss_address *known, uint8_t mask)
 
 	zassert_ok(co_lss_master_fastscan_req(&t.master, known, mask, 0, con, &t));
 	for (int i = 0; i < 1000 && t.n_con == n; i++) {
-		run_ms(FS_STEP);
+		co_bus_run_ms(FS_STEP);
 	}
 	zassert_equal(t.n_con, n + 1, "fastscan confirmed");
 	return t.err;
@@ -458,7 +443,7 @@ ZTEST(co_lss_master, test_fastscan_of_8_devices_with_random_serials)
 	}
 
 	for (int n = 0; n < N_SLAVES; n++) {
-		uint64_t t0 = t.now;
+		uint64_t t0 = bus.now;
 		uint32_t req0 = t.n_req;
 		int who = -1;
 
@@ -484,10 +469,10 @@ ZTEST(co_lss_master, test_fastscan_of_8_devices_with_random_serials)
 
 		zassert_ok(co_lss_master_config_node_id_req(&t.master, (uint8_t)(0x20 + n), 0, con,
 							    &t));
-		run_ms(1);
+		co_bus_run_ms(1);
 		zassert_ok(t.err);
 		zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_WAITING));
-		run_ms(1);
+		co_bus_run_ms(1);
 		zassert_equal(co_node_id(&t.slave[who]), 0x20 + n, "booted with its node-ID");
 	}
 	zassert_equal(t.n_boot, N_SLAVES, "every device sent its boot-up");
@@ -508,7 +493,7 @@ ZTEST(co_lss_master, test_fastscan_with_known_parts)
 	zassert_equal(co_lss_get_state(&t.slave[0]), CO_LSS_STATE_CONFIGURATION);
 	zassert_equal(co_lss_get_state(&t.slave[1]), CO_LSS_STATE_WAITING);
 	zassert_ok(co_lss_master_switch_global(&t.master, CO_LSS_MODE_WAITING));
-	run_ms(1);
+	co_bus_run_ms(1);
 
 	/* Vendor-ID and product known: 1 + 2 + 2 x 33. */
 	zassert_ok(fastscan(&known, BIT(0) | BIT(1)));
@@ -532,11 +517,11 @@ ZTEST(co_lss_master, test_fastscan_restarts_then_gives_up)
 
 	/* The slave being scanned gets a node-ID on the way: the scan restarts and ends. */
 	zassert_ok(co_lss_master_fastscan_req(&t.master, NULL, 0, 0, con, &t));
-	run_ms(FS_STEP * 40); /* into the product code */
+	co_bus_run_ms(FS_STEP * 40); /* into the product code */
 	zassert_ok(co_node_set_pending_id(&t.slave[0], 0x30));
 	zassert_ok(co_node_set_pending_id(&t.slave[1], 0x31));
 	for (int i = 0; i < 200 && t.n_con == 1; i++) {
-		run_ms(FS_STEP);
+		co_bus_run_ms(FS_STEP);
 	}
 	zassert_equal(t.n_con, 2);
 	zassert_equal(t.err, -ENODEV, "the new probe finds nobody");

@@ -26,16 +26,16 @@
 
 #include "line_internal.h"
 
+#include "co_bus.h"
+
 #include "fm_master_od.h"
 #include "fm_slave_od.h"
 
 #define MS       1000ULL
 #define MAX_NODE 6
-#define MAX_LOG  4096
-#define MAX_PEND 256
 #define MAX_CFG  24
 #define MAX_EV   32
-#define INJECTED (-1)
+#define INJECTED CO_BUS_INJECTED
 
 struct cfg_entry {
 	uint16_t index;
@@ -56,139 +56,21 @@ struct nd {
 	struct co_listener listener;
 	struct co_event ev[MAX_EV];
 	int n_ev;
-	bool used;
-	bool alive;
 	bool master;
-	bool busy; /* the controller pushes back: frames wait in the line's TX queue */
-	int side;  /* bus split: frames reach the same side only */
 	char name[8];
-};
-
-struct logged {
-	struct can_frame f;
-	uint64_t at;
-	int from; /* node index, INJECTED */
 };
 
 static struct {
 	struct nd n[MAX_NODE];
-	struct logged log[MAX_LOG];
-	int n_log;
-	struct can_frame pend[MAX_PEND];
-	int pend_from[MAX_PEND];
-	int n_pend;
-	uint64_t now;
 } t;
 
 /* --- The bus -------------------------------------------------------------------------------- */
 
-static void bus_put(const struct can_frame *f, int from)
-{
-	zassert_true(t.n_log < MAX_LOG, "log full");
-	t.log[t.n_log++] = (struct logged){.f = *f, .at = t.now, .from = from};
-	zassert_true(t.n_pend < MAX_PEND);
-	t.pend[t.n_pend] = *f;
-	t.pend_from[t.n_pend++] = from;
-}
-
-static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
-{
-	int i = (int)(intptr_t)user_data;
-
-	ARG_UNUSED(line);
-	if (t.n[i].busy) {
-		return -EAGAIN;
-	}
-	if (t.n[i].alive) {
-		bus_put(frame, i);
-	}
-	return 0;
-}
-
-/* Deliver what was sent, at the time it was sent, until nobody sends any more. */
-static void settle(void)
-{
-	for (int guard = 0; guard < 100000; guard++) {
-		bool did = false;
-
-		if (t.n_pend > 0) {
-			struct can_frame f = t.pend[0];
-			int from = t.pend_from[0];
-
-			memmove(&t.pend[0], &t.pend[1], (size_t)(t.n_pend - 1) * sizeof(t.pend[0]));
-			memmove(&t.pend_from[0], &t.pend_from[1],
-				(size_t)(t.n_pend - 1) * sizeof(t.pend_from[0]));
-			t.n_pend--;
-			for (int j = 0; j < MAX_NODE; j++) {
-				struct nd *d = &t.n[j];
-
-				if (j != from && d->used && d->alive &&
-				    (from == INJECTED || d->side == t.n[from].side)) {
-					(void)co_line_rx(&d->line, &f, t.now);
-				}
-			}
-			did = true;
-		}
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive &&
-			    k_msgq_num_used_get(&t.n[j].line.rxq) > 0U) {
-				co_line_process(&t.n[j].line, t.now);
-				did = true;
-			}
-		}
-		if (!did) {
-			return;
-		}
-	}
-	zassert_unreachable("the bus does not settle");
-}
-
-static void run_until(uint64_t at)
-{
-	settle();
-	for (int guard = 0; guard < 1000000; guard++) {
-		uint64_t next = UINT64_MAX;
-
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive) {
-				uint64_t d = co_line_next_deadline(&t.n[j].line);
-
-				next = d < next ? d : next;
-			}
-		}
-		if (next > at) {
-			break;
-		}
-		if (next > t.now) {
-			t.now = next;
-		}
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive) {
-				co_line_process(&t.n[j].line, t.now);
-			}
-		}
-		settle();
-	}
-	t.now = at;
-	for (int j = 0; j < MAX_NODE; j++) {
-		if (t.n[j].used && t.n[j].alive) {
-			co_line_process(&t.n[j].line, t.now);
-		}
-	}
-	settle();
-}
-
-static void run_ms(uint64_t ms)
-{
-	run_until(t.now + ms * MS);
-}
-
 static void inject(uint16_t id, uint8_t dlc, uint8_t b0, uint8_t b1)
 {
-	struct can_frame f = {.id = id, .dlc = dlc, .data = {b0, b1}};
+	const struct can_frame f = {.id = id, .dlc = dlc, .data = {b0, b1}};
 
-	bus_put(&f, INJECTED);
-	settle();
+	co_bus_inject(&f);
 }
 
 /* --- Nodes ----------------------------------------------------------------------------------- */
@@ -233,11 +115,9 @@ static void node_add(int i, uint8_t id, bool master)
 {
 	struct nd *d = &t.n[i];
 
-	d->used = true;
-	d->alive = true;
 	d->master = master;
 	snprintf(d->name, sizeof(d->name), "n%02x", id);
-	co_line_init_sim(&d->line, d->name, sink, (void *)(intptr_t)i);
+	co_bus_attach(i, &d->line, d->name);
 	zassert_ok(co_node_init(&d->node, d->name, &d->line,
 				master ? &fm_master_od_def : &fm_slave_od_def, &d->ram, id));
 	co_od_set_restore_cb(co_node_od(&d->node), restore, d);
@@ -284,17 +164,17 @@ static void slaves(int first)
 static void start(int i)
 {
 	zassert_ok(co_node_start(&t.n[i].node));
-	settle();
+	co_bus_settle();
 }
 
 static void start_all(void)
 {
 	for (int i = 0; i < MAX_NODE; i++) {
-		if (t.n[i].used) {
+		if (bus.port[i].used) {
 			zassert_ok(co_node_start(&t.n[i].node));
 		}
 	}
-	settle();
+	co_bus_settle();
 }
 
 static uint32_t od_u(int i, uint16_t index, uint8_t sub)
@@ -319,6 +199,7 @@ static void before(void *unused)
 {
 	ARG_UNUSED(unused);
 	memset(&t, 0, sizeof(t));
+	co_bus_init();
 }
 
 /* SAFELINE_FM_TRACE=1 prints every frame of each test (reading a failure). */
@@ -330,8 +211,8 @@ static void after(void *unused)
 	if (e == NULL || e[0] != '1') {
 		return;
 	}
-	for (int k = 0; k < t.n_log; k++) {
-		const struct logged *l = &t.log[k];
+	for (int k = 0; k < bus.n_log; k++) {
+		const struct co_bus_frame *l = &bus.log[k];
 
 		printk("%8llu.%03llu %2d %03x#", l->at / MS, l->at % MS, l->from, l->f.id);
 		for (int b = 0; b < l->f.dlc; b++) {
@@ -345,7 +226,7 @@ ZTEST_SUITE(co_mgr_fm, NULL, NULL, before, after, NULL);
 
 /* --- Log queries ---------------------------------------------------------------------------- */
 
-static bool is(const struct logged *l, uint16_t id, int from)
+static bool is(const struct co_bus_frame *l, uint16_t id, int from)
 {
 	return l->f.id == id && (from == -2 || l->from == from);
 }
@@ -353,8 +234,8 @@ static bool is(const struct logged *l, uint16_t id, int from)
 /* First frame @p id (from node @p from, -2: anyone) at or after @p since [µs]; -1 if none. */
 static int find(uint16_t id, int from, uint64_t since)
 {
-	for (int k = 0; k < t.n_log; k++) {
-		if (t.log[k].at >= since && is(&t.log[k], id, from)) {
+	for (int k = 0; k < bus.n_log; k++) {
+		if (bus.log[k].at >= since && is(&bus.log[k], id, from)) {
 			return k;
 		}
 	}
@@ -365,16 +246,16 @@ static int count(uint16_t id, int from, uint64_t since)
 {
 	int n = 0;
 
-	for (int k = 0; k < t.n_log; k++) {
-		n += t.log[k].at >= since && is(&t.log[k], id, from) ? 1 : 0;
+	for (int k = 0; k < bus.n_log; k++) {
+		n += bus.log[k].at >= since && is(&bus.log[k], id, from) ? 1 : 0;
 	}
 	return n;
 }
 
 static int find_nmt(uint8_t cs, uint8_t id, int from, uint64_t since)
 {
-	for (int k = 0; k < t.n_log; k++) {
-		const struct logged *l = &t.log[k];
+	for (int k = 0; k < bus.n_log; k++) {
+		const struct co_bus_frame *l = &bus.log[k];
 
 		if (l->at >= since && l->f.id == 0 && l->f.dlc == 2 && l->f.data[0] == cs &&
 		    l->f.data[1] == id && (from == -2 || l->from == from)) {
@@ -387,7 +268,7 @@ static int find_nmt(uint8_t cs, uint8_t id, int from, uint64_t since)
 static uint64_t at_ms(int k)
 {
 	zassert_true(k >= 0, "frame not found");
-	return t.log[k].at / MS;
+	return bus.log[k].at / MS;
 }
 
 static int n_ev(int i, enum co_mgr_fm_event what)
@@ -405,7 +286,7 @@ static int active_count(void)
 	int n = 0;
 
 	for (int i = 0; i < MAX_NODE; i++) {
-		if (t.n[i].used && t.n[i].master && t.n[i].alive &&
+		if (bus.port[i].used && t.n[i].master && bus.port[i].alive &&
 		    fm(i).state == CO_MGR_FM_ACTIVE) {
 			n++;
 		}
@@ -422,26 +303,26 @@ ZTEST(co_mgr_fm, test_s9_53_alone_cold_boot_timeline)
 	candidate(0, 5, 1);
 	slaves(1);
 	start_all();
-	run_ms(12000);
+	co_bus_run_ms(12000);
 
 	/* 705#00 -> +500 073 -> +100 000#8200 -> (warm) +500 073 -> +100 072 -> +1550 071. */
 	zassert_equal(at_ms(find(0x705, 0, 0)), 0);
 	k = find(0x073, 0, 0);
 	zassert_equal(at_ms(k), 500);
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(bus.log[k].f.dlc, 0);
 	k = find_nmt(0x82, 0, 0, 0);
 	zassert_equal(at_ms(k), 600);
-	zassert_equal(t.log[k].from, 0);
+	zassert_equal(bus.log[k].from, 0);
 	zassert_equal(at_ms(find(0x705, 0, 600 * MS)), 600, "warm boot-up");
 	zassert_equal(at_ms(find(0x073, 0, 601 * MS)), 1100);
 	k = find(0x072, 0, 0);
 	zassert_equal(at_ms(k), 1200);
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(bus.log[k].f.dlc, 0);
 	k = find(0x071, 0, 0);
 	zassert_equal(at_ms(k), 2750);
-	zassert_equal(t.log[k].f.dlc, 2);
-	zassert_equal(t.log[k].f.data[0], 1);
-	zassert_equal(t.log[k].f.data[1], 5);
+	zassert_equal(bus.log[k].f.dlc, 2);
+	zassert_equal(bus.log[k].f.data[0], 1);
+	zassert_equal(bus.log[k].f.data[1], 5);
 	/* Then the NMT startup (Reset Communication of all), then 076h every 4050 ms. */
 	zassert_equal(at_ms(find_nmt(0x82, 0, 0, 2750 * MS)), 2750);
 	zassert_equal(at_ms(find(0x076, 0, 0)), 2750 + 4050);
@@ -461,7 +342,7 @@ static void lone_active(uint8_t id, uint8_t prio)
 {
 	candidate(0, id, prio);
 	start_all();
-	run_ms(500 + 100 + 500 + 100 + prio * 1500 + id * 10 + 50);
+	co_bus_run_ms(500 + 100 + 500 + 100 + prio * 1500 + id * 10 + 50);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
 }
 
@@ -469,12 +350,12 @@ ZTEST(co_mgr_fm, test_reset_all_survives_a_busy_controller)
 {
 	candidate(0, 5, 1);
 	start_all();
-	run_ms(599);
+	co_bus_run_ms(599);
 	/* The cold boot's 000#8200 is due at 600 ms while the controller cannot take it. */
-	t.n[0].busy = true;
-	run_ms(50);
-	t.n[0].busy = false;
-	run_ms(100);
+	bus.port[0].busy = true;
+	co_bus_run_ms(50);
+	bus.port[0].busy = false;
+	co_bus_run_ms(100);
 	/* Sent at the line's next round (the heartbeat at 700 ms), not dropped by our reset. */
 	zassert_equal(at_ms(find_nmt(0x82, 0, 0, 0)), 700);
 }
@@ -485,16 +366,16 @@ ZTEST(co_mgr_fm, test_s9_54_active_master_answers_073)
 	int k;
 
 	lone_active(10, 0);
-	run_ms(100);
-	since = t.now;
+	co_bus_run_ms(100);
+	since = bus.now;
 	inject(0x073, 0, 0, 0);
-	run_ms(100);
+	co_bus_run_ms(100);
 	k = find(0x071, 0, since);
 	zassert_true(k >= 0);
-	zassert_true(t.log[k].at - since <= 100 * MS, "within 1F90h:01");
-	zassert_equal(t.log[k].f.dlc, 2);
-	zassert_equal(t.log[k].f.data[0], 0x00);
-	zassert_equal(t.log[k].f.data[1], 0x0A);
+	zassert_true(bus.log[k].at - since <= 100 * MS, "within 1F90h:01");
+	zassert_equal(bus.log[k].f.dlc, 2);
+	zassert_equal(bus.log[k].f.data[0], 0x00);
+	zassert_equal(bus.log[k].f.data[1], 0x0A);
 }
 
 ZTEST(co_mgr_fm, test_s9_55_lower_priority_candidate_becomes_slave)
@@ -503,14 +384,14 @@ ZTEST(co_mgr_fm, test_s9_55_lower_priority_candidate_becomes_slave)
 
 	candidate(0, 5, 2);
 	start_all();
-	run_ms(500);
+	co_bus_run_ms(500);
 	zassert_equal(count(0x073, 0, 0), 1);
-	since = t.now + 1; /* after its 073h */
+	since = bus.now + 1; /* after its 073h */
 	inject(0x071, 2, 0x00, 0x0A);
 	/* Keep the master's heartbeat coming. */
 	for (int i = 0; i < 50; i++) {
 		inject(0x70A, 1, 0x05, 0);
-		run_ms(100);
+		co_bus_run_ms(100);
 	}
 	zassert_equal(count(0x072, 0, since) + count(0x071, 0, since) + count(0x076, 0, since) +
 			      count(0x073, 0, since) + count(0x000, 0, since),
@@ -542,17 +423,17 @@ ZTEST(co_mgr_fm, test_s9_56_higher_priority_candidate_forces)
 
 	candidate(0, 5, 0);
 	start_all();
-	run_ms(500);
+	co_bus_run_ms(500);
 	inject(0x071, 2, 0x02, 0x0A);
 	k = find(0x076, 0, 0);
 	zassert_true(k >= 0);
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(bus.log[k].f.dlc, 0);
 	zassert_equal(at_ms(k), 500);
 	zassert_equal(fm(0).state, CO_MGR_FM_FORCED);
 	zassert_equal(n_ev(0, CO_MGR_FM_EV_FORCE), 1);
 	/* The master resets the network: we negotiate from a warm boot. */
 	inject(0x000, 2, 0x82, 0x00);
-	run_ms(500 + 100 + 5 * 10 + 10);
+	co_bus_run_ms(500 + 100 + 5 * 10 + 10);
 	zassert_equal(at_ms(find(0x072, 0, 0)), 500 + 500 + 100);
 	zassert_equal(at_ms(find(0x071, 0, 0)), 500 + 500 + 100 + 50);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
@@ -566,17 +447,17 @@ ZTEST(co_mgr_fm, test_lower_priority_071_during_negotiation_forces)
 	candidate(0, 5, 0);
 	start_all();
 	/* Cold: 073h at 500, 000#8200 at 600; warm: 073h at 1100, 072h at 1200, W = 50 ms. */
-	run_ms(1220);
+	co_bus_run_ms(1220);
 	zassert_equal(fm(0).state, CO_MGR_FM_NEGOTIATE);
 	inject(0x071, 2, 0x02, 0x0A);
 	k = find(0x076, 0, 1200 * MS);
 	zassert_true(k >= 0, "076h to the lower-priority node");
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(bus.log[k].f.dlc, 0);
 	zassert_equal(at_ms(k), 1220);
 	zassert_equal(fm(0).state, CO_MGR_FM_FORCED);
 	zassert_equal(n_ev(0, CO_MGR_FM_EV_FORCE), 1);
 	/* No announcement of our own while the other resets the network. */
-	run_ms(100);
+	co_bus_run_ms(100);
 	zassert_equal(count(0x071, 0, 0), 0);
 }
 
@@ -590,7 +471,7 @@ ZTEST(co_mgr_fm, test_lower_priority_winner_is_forced_once)
 
 	candidate(0, 5, 0);
 	start_all();
-	run_ms(1220);
+	co_bus_run_ms(1220);
 	inject(0x071, 2, 0x02, 0x0A);
 	first = find(0x076, 0, 1200 * MS);
 	zassert_true(first >= 0, "the first 076h");
@@ -600,16 +481,16 @@ ZTEST(co_mgr_fm, test_lower_priority_winner_is_forced_once)
 	 * 073h 500 ms after the reset, a 072h would come at 600 and our W is 50 ms).
 	 */
 	inject(0x000, 2, 0x82, 0x00);
-	run_ms(560);
+	co_bus_run_ms(560);
 	zassert_equal(fm(0).state, CO_MGR_FM_DETECT);
 	inject(0x072, 0, 0, 0);
-	run_ms(10);
+	co_bus_run_ms(10);
 	inject(0x071, 2, 0x02, 0x0A);
 	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
 	zassert_equal(fm(0).master_id, 0x0A);
 	for (int i = 0; i < 5; i++) {
 		inject(0x70A, 1, 0x05, 0);
-		run_ms(100);
+		co_bus_run_ms(100);
 	}
 	zassert_equal(count(0x076, first + 1, 0), 0, "no second 076h");
 	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
@@ -624,21 +505,21 @@ ZTEST(co_mgr_fm, test_076_ignored_unless_active_master)
 	candidate(0, 5, 2);
 	start_all();
 	/* In the negotiation time delay: the timeline goes on unchanged (073h at 500). */
-	run_ms(200);
+	co_bus_run_ms(200);
 	inject(0x076, 0, 0, 0);
-	run_ms(300);
+	co_bus_run_ms(300);
 	zassert_equal(at_ms(find(0x073, 0, 0)), 500);
 	zassert_equal(find_nmt(0x82, 0, 0, 0), -1, "no reset for a 076h before the detection");
 	/* As a slave of node 0Ah (priority 0): no reset, no state change. */
 	inject(0x071, 2, 0x00, 0x0A);
 	zassert_equal(fm(0).state, CO_MGR_FM_SLAVE);
-	since = t.now + 1; /* after its 073h */
+	since = bus.now + 1; /* after its 073h */
 	for (int i = 0; i < 10; i++) {
 		inject(0x70A, 1, 0x05, 0);
 		if (i == 3) {
 			inject(0x076, 0, 0, 0);
 		}
-		run_ms(100);
+		co_bus_run_ms(100);
 	}
 	zassert_equal(count(0x000, 0, since), 0, "a slave does not reset the network on 076h");
 	zassert_equal(count(0x071, 0, since) + count(0x072, 0, since) + count(0x073, 0, since), 0);
@@ -651,12 +532,12 @@ ZTEST(co_mgr_fm, test_s9_57_second_072_restarts_the_slot_timer)
 	candidate(0, 5, 1);
 	start_all();
 	/* Cold: 073 at 500, 8200 at 600; warm: 073 at 1100, detection ends at 1200. */
-	run_ms(1150);
+	co_bus_run_ms(1150);
 	inject(0x072, 0, 0, 0);
-	run_ms(150); /* 1300 */
+	co_bus_run_ms(150); /* 1300 */
 	zassert_equal(count(0x072, 0, 0), 0, "saw one: does not send its own");
 	inject(0x072, 0, 0, 0);
-	run_ms(1600);
+	co_bus_run_ms(1600);
 	/* W = 1 x 1500 + 5 x 10 after the last 072h. */
 	zassert_equal(at_ms(find(0x071, 0, 0)), 1300 + 1550);
 	zassert_equal(count(0x072, 0, 0), 0);
@@ -668,7 +549,7 @@ ZTEST(co_mgr_fm, test_s9_57_shortest_wait_answers)
 	candidate(0, 5, 1);
 	candidate(1, 3, 1);
 	start_all();
-	run_ms(4000);
+	co_bus_run_ms(4000);
 	zassert_equal(at_ms(find(0x071, 1, 0)), 1200 + 1530);
 	/* Node 5 heard it before its own slot and never announced itself. */
 	zassert_equal(count(0x071, 0, 0), 0);
@@ -683,22 +564,22 @@ ZTEST(co_mgr_fm, test_s9_58_master_heartbeat_lost)
 	candidate(0, 5, 2);
 	cfg(0, 0x1016, 1, (0x0AU << 16) | 300U, 4);
 	start_all();
-	run_ms(500);
+	co_bus_run_ms(500);
 	inject(0x071, 2, 0x00, 0x0A);
 	for (int i = 0; i < 10; i++) {
 		inject(0x70A, 1, 0x05, 0);
-		run_ms(100);
+		co_bus_run_ms(100);
 	}
-	last = t.now - 100 * MS;
-	run_ms(1000);
+	last = bus.now - 100 * MS;
+	co_bus_run_ms(1000);
 	k = find_nmt(0x82, 0, 0, last);
 	zassert_true(k >= 0, "000#8200 after the loss");
-	zassert_equal(t.log[k].at - last, 300 * MS, "within the consumer time 1016h");
+	zassert_equal(bus.log[k].at - last, 300 * MS, "within the consumer time 1016h");
 	zassert_equal(n_ev(0, CO_MGR_FM_EV_LOST), 1);
 	/* It negotiates again and takes over: W = 2 x 1500 + 5 x 10. */
-	run_ms(4000);
+	co_bus_run_ms(4000);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
-	zassert_equal(at_ms(find(0x071, 0, 0)), t.log[k].at / MS + 500 + 100 + 3050);
+	zassert_equal(at_ms(find(0x071, 0, 0)), bus.log[k].at / MS + 500 + 100 + 3050);
 }
 
 ZTEST(co_mgr_fm, test_hb_supervision_default_without_1016)
@@ -707,10 +588,10 @@ ZTEST(co_mgr_fm, test_hb_supervision_default_without_1016)
 
 	candidate(0, 5, 2);
 	start_all();
-	run_ms(500);
+	co_bus_run_ms(500);
 	inject(0x071, 2, 0x00, 0x0A);
 	/* No heartbeat at all: the timeout runs from the announcement. */
-	run_ms(CONFIG_CANOPEN_MGR_FLYING_HB_TIME + 10);
+	co_bus_run_ms(CONFIG_CANOPEN_MGR_FLYING_HB_TIME + 10);
 	k = find_nmt(0x82, 0, 0, 501 * MS);
 	zassert_equal(at_ms(k), 500 + CONFIG_CANOPEN_MGR_FLYING_HB_TIME);
 }
@@ -722,10 +603,10 @@ ZTEST(co_mgr_fm, test_s9_59_self_starter_starts_the_network)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x02, 4);
 	start_all();
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	k = find(0x075, 0, 0);
 	zassert_equal(at_ms(k), 500);
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(bus.log[k].f.dlc, 0);
 	/* No 074h within 100 ms, then 7 x 15 ms. */
 	zassert_equal(at_ms(find_nmt(0x01, 0x00, 0, 0)), 500 + 100 + 105);
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_OPERATIONAL);
@@ -738,9 +619,9 @@ ZTEST(co_mgr_fm, test_s9_59_self_starter_defers_to_a_master_capable_device)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x02, 4);
 	start_all();
-	run_ms(550);
+	co_bus_run_ms(550);
 	inject(0x074, 0, 0, 0);
-	run_ms(2000);
+	co_bus_run_ms(2000);
 	zassert_equal(find_nmt(0x01, 0x00, 0, 0), -1, "no start");
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_PRE_OPERATIONAL);
 	zassert_equal(n_ev(0, CO_MGR_FM_EV_CAPABLE), 1);
@@ -751,9 +632,9 @@ ZTEST(co_mgr_fm, test_s9_59_self_starter_sends_no_second_start)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x02, 4);
 	start_all();
-	run_ms(650); /* in its node-ID slot */
+	co_bus_run_ms(650); /* in its node-ID slot */
 	inject(0x000, 2, 0x01, 0x00);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(find_nmt(0x01, 0x00, 0, 0), -1, "another's start came first");
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_OPERATIONAL);
 }
@@ -767,13 +648,13 @@ ZTEST(co_mgr_fm, test_s9_60_master_capable_answers_075)
 	cfg(0, 0x1F80, 0, 0x01, 4);
 	candidate(1, 5, 2);
 	start_all();
-	run_ms(510);
+	co_bus_run_ms(510);
 	inject(0x071, 2, 0x00, 0x0A);
 	inject(0x075, 0, 0, 0);
-	zassert_equal(count(0x074, 0, t.now), 1);
-	zassert_equal(count(0x074, 1, t.now), 1, "a candidate that is a slave answers too");
-	k = find(0x074, 0, t.now);
-	zassert_equal(t.log[k].f.dlc, 0);
+	zassert_equal(count(0x074, 0, bus.now), 1);
+	zassert_equal(count(0x074, 1, bus.now), 1, "a candidate that is a slave answers too");
+	k = find(0x074, 0, bus.now);
+	zassert_equal(bus.log[k].f.dlc, 0);
 }
 
 ZTEST(co_mgr_fm, test_s9_61_self_starting_slave_sends_nothing)
@@ -781,7 +662,7 @@ ZTEST(co_mgr_fm, test_s9_61_self_starting_slave_sends_nothing)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x08, 4);
 	start_all();
-	run_ms(2000);
+	co_bus_run_ms(2000);
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_OPERATIONAL);
 	zassert_equal(count(0x000, 0, 0) + count(0x075, 0, 0), 0);
 }
@@ -791,7 +672,7 @@ ZTEST(co_mgr_fm, test_s9_61_self_starting_28h_as_08h)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x28, 4);
 	start_all();
-	run_ms(2000);
+	co_bus_run_ms(2000);
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_OPERATIONAL);
 	zassert_equal(count(0x000, 0, 0) + count(0x075, 0, 0) + count(0x073, 0, 0), 0);
 }
@@ -801,7 +682,7 @@ ZTEST(co_mgr_fm, test_s9_59_self_starter_22h_as_02h)
 	node_add(0, 7, true);
 	cfg(0, 0x1F80, 0, 0x22, 4);
 	start_all();
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(at_ms(find(0x075, 0, 0)), 500);
 	zassert_equal(at_ms(find_nmt(0x01, 0x00, 0, 0)), 500 + 100 + 105);
 }
@@ -811,7 +692,7 @@ ZTEST(co_mgr_fm, test_wrong_dlc_ignored)
 	uint64_t since;
 
 	lone_active(10, 0);
-	since = t.now;
+	since = bus.now;
 	/* 073h, 076h, 072h, 075h with data, 071h with 1 or 3 bytes: none of them counts. */
 	inject(0x073, 1, 0, 0);
 	inject(0x076, 2, 0, 0);
@@ -819,7 +700,7 @@ ZTEST(co_mgr_fm, test_wrong_dlc_ignored)
 	inject(0x075, 1, 0, 0);
 	inject(0x071, 1, 0x00, 0);
 	inject(0x071, 3, 0x00, 0x01);
-	run_ms(200);
+	co_bus_run_ms(200);
 	zassert_equal(count(0x071, 0, since) + count(0x074, 0, since) + count(0x000, 0, since), 0);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
 	/* The same frames with the right DLC are answered. */
@@ -833,11 +714,11 @@ ZTEST(co_mgr_fm, test_wrong_dlc_071_does_not_stop_negotiation)
 {
 	candidate(0, 5, 2);
 	start_all();
-	run_ms(500);
+	co_bus_run_ms(500);
 	inject(0x071, 1, 0x00, 0x0A);
 	inject(0x071, 8, 0x00, 0x0A);
 	zassert_equal(fm(0).state, CO_MGR_FM_DETECT);
-	run_ms(100);
+	co_bus_run_ms(100);
 	zassert_equal(count(0x000, 0, 0), 1, "cold boot, nobody answered: 000#8200");
 }
 
@@ -846,13 +727,13 @@ ZTEST(co_mgr_fm, test_bus_off_during_negotiation_restarts_it)
 	candidate(0, 5, 1);
 	start_all();
 	/* Negotiating from 1200 ms (072h), own slot at 2750 ms. */
-	run_ms(1300);
+	co_bus_run_ms(1300);
 	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
-	run_ms(100);
+	co_bus_run_ms(100);
 	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
-	settle();
+	co_bus_settle();
 	zassert_equal(fm(0).state, CO_MGR_FM_DELAY);
-	run_ms(3000);
+	co_bus_run_ms(3000);
 	/* Again from F1: 073h +500, (warm) 072h +100, 071h +1550. */
 	zassert_equal(at_ms(find(0x073, 0, 1401 * MS)), 1900);
 	zassert_equal(at_ms(find(0x072, 0, 1401 * MS)), 2000);
@@ -865,7 +746,7 @@ ZTEST(co_mgr_fm, test_bus_off_of_the_active_master_keeps_it)
 	lone_active(10, 0);
 	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_BUS_OFF);
 	co_line_inject_event(&t.n[0].line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_ACTIVE);
-	settle();
+	co_bus_settle();
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE, "its 076h cycle finds a second master");
 }
 
@@ -928,7 +809,7 @@ ZTEST(co_mgr_fm, test_two_candidates_higher_priority_wins)
 	/* Node 3 has priority 0, node 2 priority 1: the priority decides, not the node-ID. */
 	network(3, 0, 2, 1);
 	start_all();
-	run_ms(6000);
+	co_bus_run_ms(6000);
 	check_stable(0, 1);
 	zassert_equal(count(0x071, 1, 0), 0, "the loser never announced itself");
 	zassert_equal(n_ev(1, CO_MGR_FM_EV_MASTER), 1);
@@ -941,7 +822,7 @@ ZTEST(co_mgr_fm, test_two_candidates_equal_priority_lower_id_wins)
 {
 	network(3, 1, 2, 1);
 	start_all();
-	run_ms(6000);
+	co_bus_run_ms(6000);
 	check_stable(1, 0);
 	zassert_equal(at_ms(find(0x071, 1, 0)), 1200 + 1500 + 20);
 }
@@ -954,22 +835,22 @@ ZTEST(co_mgr_fm, test_active_master_killed_other_takes_over)
 
 	network(3, 0, 2, 1);
 	start_all();
-	run_ms(6000);
+	co_bus_run_ms(6000);
 	check_stable(0, 1);
-	killed = t.now;
-	t.n[0].alive = false;
-	run_ms(5000);
+	killed = bus.now;
+	bus.port[0].alive = false;
+	co_bus_run_ms(5000);
 	zassert_equal(fm(1).state, CO_MGR_FM_ACTIVE);
 	zassert_equal(n_ev(1, CO_MGR_FM_EV_LOST), 1);
 	k = find_nmt(0x82, 0, 1, killed);
 	zassert_true(k >= 0);
-	detect = t.log[k].at;
+	detect = bus.log[k].at;
 	k = find(0x071, 1, killed);
-	announce = t.log[k].at;
-	zassert_equal(t.log[k].f.data[0], 1);
-	zassert_equal(t.log[k].f.data[1], 2);
+	announce = bus.log[k].at;
+	zassert_equal(bus.log[k].f.data[0], 1);
+	zassert_equal(bus.log[k].f.data[1], 2);
 	k = find_nmt(0x82, 0, 1, announce);
-	first_nmt = t.log[k].at;
+	first_nmt = bus.log[k].at;
 	/* Bound from 1F90h: heartbeat time + 1F90:02 + 1F90:01 + W (1 x 1500 + 2 x 10). */
 	bound = (300 + 500 + 100 + 1520) * MS;
 	printk("flying master take-over: killed at %llu ms; loss detected +%llu ms; "
@@ -979,7 +860,7 @@ ZTEST(co_mgr_fm, test_active_master_killed_other_takes_over)
 	       (first_nmt - killed) / MS, bound / MS);
 	zassert_true(first_nmt - killed <= bound, "within the 1F90h bound");
 	/* The slaves run again under the new master. */
-	run_ms(2000);
+	co_bus_run_ms(2000);
 	for (int s = 2; s <= 4; s++) {
 		zassert_equal(co_nmt_get_state(&t.n[s].node), CO_NMT_OPERATIONAL);
 	}
@@ -993,25 +874,25 @@ ZTEST(co_mgr_fm, test_force_negotiation_by_higher_priority)
 
 	network(3, 1, 2, 0);
 	/* Node 3 (priority 1) runs alone first. */
-	t.n[1].alive = false;
+	bus.port[1].alive = false;
 	for (int i = 0; i < MAX_NODE; i++) {
-		if (t.n[i].used && i != 1) {
+		if (bus.port[i].used && i != 1) {
 			zassert_ok(co_node_start(&t.n[i].node));
 		}
 	}
-	run_ms(5000);
+	co_bus_run_ms(5000);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
 	/* Node 2 (priority 0) powers on. */
-	joined = t.now;
-	t.n[1].alive = true;
+	joined = bus.now;
+	bus.port[1].alive = true;
 	start(1);
-	run_ms(600);
+	co_bus_run_ms(600);
 	k = find(0x076, 1, joined);
 	zassert_true(k >= 0, "the higher-priority candidate forces");
 	zassert_equal(at_ms(k) * MS - joined, 500 * MS);
-	zassert_true(find_nmt(0x82, 0, 0, t.log[k].at) >= 0, "the active master resets all");
+	zassert_true(find_nmt(0x82, 0, 0, bus.log[k].at) >= 0, "the active master resets all");
 	zassert_equal(n_ev(0, CO_MGR_FM_EV_RESIGN), 1);
-	run_ms(5000);
+	co_bus_run_ms(5000);
 	check_stable(1, 0);
 }
 
@@ -1034,12 +915,12 @@ ZTEST(co_mgr_fm, test_request_nmt_through_the_active_master)
 	n_con = 0;
 	network(3, 0, 2, 1);
 	start_all();
-	run_ms(6000);
+	co_bus_run_ms(6000);
 	check_stable(0, 1);
 	/* Node 2 (a slave now) asks the active master to stop node 0Ah: 1F82h:0A = 04h. */
-	since = t.now;
+	since = bus.now;
 	zassert_ok(co_mgr_request_nmt(&t.n[1].node, 0, 0x0A, 0x04, req_con, NULL));
-	run_ms(50);
+	co_bus_run_ms(50);
 	zassert_equal(n_con, 1);
 	zassert_equal(con_abort, 0U);
 	zassert_true(find(0x603, 1, since) >= 0, "an SDO request to node 3");
@@ -1048,13 +929,13 @@ ZTEST(co_mgr_fm, test_request_nmt_through_the_active_master)
 	zassert_equal(co_nmt_get_state(&t.n[2].node), CO_NMT_STOPPED);
 	/* Pre-operational for all nodes (80h): the master applies it to itself too. */
 	zassert_ok(co_mgr_request_nmt(&t.n[1].node, 0, 0x80, 0x7F, req_con, NULL));
-	run_ms(50);
+	co_bus_run_ms(50);
 	zassert_equal(con_abort, 0U);
 	zassert_true(find_nmt(0x80, 0x00, 0, since) >= 0);
 	zassert_equal(co_nmt_get_state(&t.n[0].node), CO_NMT_PRE_OPERATIONAL);
 	/* Guarding of 0Ah needs a guard time in the master's 1F81h: the master refuses. */
 	zassert_ok(co_mgr_request_guarding(&t.n[1].node, 0, 0x0A, true, req_con, NULL));
-	run_ms(50);
+	co_bus_run_ms(50);
 	zassert_equal(n_con, 3);
 	zassert_equal(con_abort, CO_SDO_AB_DATA_DEV_STATE);
 	/* Refused locally. */
@@ -1068,7 +949,7 @@ ZTEST(co_mgr_fm, test_request_nmt_without_a_known_master)
 {
 	candidate(0, 5, 1);
 	start_all();
-	run_ms(100);
+	co_bus_run_ms(100);
 	zassert_equal(co_mgr_request_nmt(&t.n[0].node, 0, 0x0A, 0x05, req_con, NULL), -ENOENT);
 }
 
@@ -1078,21 +959,21 @@ ZTEST(co_mgr_fm, test_split_two_active_masters_resolve)
 
 	network(3, 0, 2, 1);
 	start_all();
-	run_ms(6000);
+	co_bus_run_ms(6000);
 	check_stable(0, 1);
 	/* Split: node 3 with slave 0Ah, node 2 with 0Bh and 0Ch. */
-	t.n[1].side = 1;
-	t.n[3].side = 1;
-	t.n[4].side = 1;
-	run_ms(5000);
+	bus.port[1].side = 1;
+	bus.port[3].side = 1;
+	bus.port[4].side = 1;
+	co_bus_run_ms(5000);
 	zassert_equal(fm(0).state, CO_MGR_FM_ACTIVE);
 	zassert_equal(fm(1).state, CO_MGR_FM_ACTIVE, "each side has its master");
 	/* Joined again: the 076h cycles make one reset the network and all negotiate. */
-	joined = t.now;
+	joined = bus.now;
 	for (int i = 0; i < MAX_NODE; i++) {
-		t.n[i].side = 0;
+		bus.port[i].side = 0;
 	}
-	run_ms(15000);
+	co_bus_run_ms(15000);
 	zassert_true(count(0x076, -2, joined) >= 1);
 	check_stable(0, 1);
 	printk("split resolved: 076h after %llu ms of the join\n",

@@ -26,6 +26,8 @@
 #include <canopen/node.h>
 #include <canopen/storage.h>
 
+#include "co_bus.h"
+
 #include "mgr_master_od.h"
 #include "mgr_slave_od.h"
 
@@ -40,7 +42,6 @@ static const uint32_t serials[N_SLAVES] = {0x1001, 0x1002, 0x1003};
 
 static struct {
 	struct co_line line;
-	uint64_t now;
 	uint32_t n_lss_req;
 	struct co_node master;
 	struct mgr_master_od_ram mram;
@@ -54,27 +55,13 @@ static struct {
 	int n_lss_ind;
 } t;
 
-static int sink(struct co_line *line, const struct can_frame *f, void *user_data)
+/* Counts the LSS requests the line sends. */
+static void tap(const struct can_frame *f, int from)
 {
+	ARG_UNUSED(from);
 	if (f->id == CO_LSS_MASTER_COB_ID) {
 		t.n_lss_req++;
 	}
-	return 0;
-}
-
-static void run_until(uint64_t at)
-{
-	while (true) {
-		uint64_t next = co_line_next_deadline(&t.line);
-
-		if (next == UINT64_MAX || next > at) {
-			break;
-		}
-		t.now = MAX(next, t.now);
-		co_line_process(&t.line, t.now);
-	}
-	t.now = at;
-	co_line_process(&t.line, t.now);
 }
 
 static void put(struct co_od *od, uint16_t index, uint8_t sub, uint32_t value)
@@ -123,7 +110,10 @@ static void lss_ind(struct co_node *node, uint8_t id, int err, const struct co_l
 static void before(void *unused)
 {
 	memset(&t, 0, sizeof(t));
-	co_line_init_sim(&t.line, "sim", sink, NULL);
+	co_bus_init();
+	co_bus_attach(0, &t.line, "sim");
+	bus.tap = tap;
+	bus.no_log = true;
 	zassert_ok(co_node_init(&t.master, "master", &t.line, &mgr_master_od_def, &t.mram, MASTER));
 	co_od_set_restore_cb(co_node_od(&t.master), master_restore, NULL);
 #if defined(CONFIG_CANOPEN_MGR_LSS_ASSIGN)
@@ -157,7 +147,7 @@ ZTEST(co_mgr_lss, test_missing_slaves_are_found_given_their_id_and_booted)
 	if (!IS_ENABLED(CONFIG_CANOPEN_MGR_LSS_ASSIGN)) {
 		ztest_test_skip();
 	}
-	run_until(15000 * MS);
+	co_bus_run_until(15000 * MS);
 	zassert_equal(t.n_lss_ind, 4, "every missing slave searched, once");
 	zassert_equal(t.lss_err[2], 0 + 1);
 	zassert_equal(t.lss_serial[2], 0x1003);
@@ -186,13 +176,13 @@ ZTEST(co_mgr_lss, test_missing_slaves_are_found_given_their_id_and_booted)
 	/* Searched once per reset: later B results send nothing. */
 	uint32_t n = t.n_lss_req;
 
-	run_until(t.now + 5000 * MS);
+	co_bus_run_until(bus.now + 5000 * MS);
 	zassert_equal(t.n_lss_req, n);
 	zassert_equal(co_mgr_lss_search(&t.master, 6), -EINVAL, "not assigned");
 	zassert_equal(co_mgr_lss_search(&t.master, 0), -EINVAL);
 	t.lss_err[4] = 0;
 	zassert_ok(co_mgr_lss_search(&t.master, 4), "asked again by the application");
-	run_until(t.now + 5000 * MS);
+	co_bus_run_until(bus.now + 5000 * MS);
 	zassert_true(t.n_lss_req > n);
 	zassert_equal(t.n_lss_ind, 5);
 #endif
@@ -203,7 +193,7 @@ ZTEST(co_mgr_lss, test_turned_off_sends_no_lss)
 	if (IS_ENABLED(CONFIG_CANOPEN_MGR_LSS_ASSIGN)) {
 		ztest_test_skip();
 	}
-	run_until(15000 * MS);
+	co_bus_run_until(15000 * MS);
 	zassert_equal(t.n_lss_req, 0);
 	for (int i = 0; i < N_SLAVES; i++) {
 		zassert_equal(co_node_id(&t.slave[i]), CO_NODE_ID_UNCONFIGURED);

@@ -28,6 +28,8 @@
 
 #include "line_internal.h"
 
+#include "co_bus.h"
+
 #include "sdom_mgr_od.h"
 #include "sdom_plain_od.h"
 #include "sdom_slave_od.h"
@@ -35,10 +37,8 @@
 
 #define MS       1000ULL
 #define MAX_NODE 5
-#define MAX_LOG  4096
-#define MAX_PEND 256
 #define MAX_CFG  16
-#define INJECTED (-1)
+#define INJECTED CO_BUS_INJECTED
 
 #define MGR   0
 #define SRD   1
@@ -69,134 +69,22 @@ struct nd {
 	} ram;
 	struct cfg_entry cfg[MAX_CFG];
 	int n_cfg;
-	bool used;
-	bool alive;
 	char name[8];
-};
-
-struct logged {
-	struct can_frame f;
-	uint64_t at;
-	int from; /* node index, INJECTED */
 };
 
 static struct {
 	struct nd n[MAX_NODE];
-	struct logged log[MAX_LOG];
-	int n_log;
-	struct can_frame pend[MAX_PEND];
-	int pend_from[MAX_PEND];
-	int n_pend;
-	uint64_t now;
 	uint32_t su;      /* the manager's 1F80h, 01h when 0 */
 	uint32_t boot_ms; /* what network() lets run after the start, 2000 ms when 0 */
 } t;
 
 /* --- The bus -------------------------------------------------------------------------------- */
 
-static void bus_put(const struct can_frame *f, int from)
-{
-	zassert_true(t.n_log < MAX_LOG, "log full");
-	t.log[t.n_log++] = (struct logged){.f = *f, .at = t.now, .from = from};
-	zassert_true(t.n_pend < MAX_PEND);
-	t.pend[t.n_pend] = *f;
-	t.pend_from[t.n_pend++] = from;
-}
-
-static int sink(struct co_line *line, const struct can_frame *frame, void *user_data)
-{
-	int i = (int)(intptr_t)user_data;
-
-	ARG_UNUSED(line);
-	if (t.n[i].alive) {
-		bus_put(frame, i);
-	}
-	return 0;
-}
-
-/* Deliver what was sent, at the time it was sent, until nobody sends any more. */
-static void settle(void)
-{
-	for (int guard = 0; guard < 100000; guard++) {
-		bool did = false;
-
-		if (t.n_pend > 0) {
-			struct can_frame f = t.pend[0];
-			int from = t.pend_from[0];
-
-			memmove(&t.pend[0], &t.pend[1], (size_t)(t.n_pend - 1) * sizeof(t.pend[0]));
-			memmove(&t.pend_from[0], &t.pend_from[1],
-				(size_t)(t.n_pend - 1) * sizeof(t.pend_from[0]));
-			t.n_pend--;
-			for (int j = 0; j < MAX_NODE; j++) {
-				struct nd *d = &t.n[j];
-
-				if (j != from && d->used && d->alive) {
-					(void)co_line_rx(&d->line, &f, t.now);
-				}
-			}
-			did = true;
-		}
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive &&
-			    k_msgq_num_used_get(&t.n[j].line.rxq) > 0U) {
-				co_line_process(&t.n[j].line, t.now);
-				did = true;
-			}
-		}
-		if (!did) {
-			return;
-		}
-	}
-	zassert_unreachable("the bus does not settle");
-}
-
-static void run_until(uint64_t at)
-{
-	settle();
-	for (int guard = 0; guard < 1000000; guard++) {
-		uint64_t next = UINT64_MAX;
-
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive) {
-				uint64_t d = co_line_next_deadline(&t.n[j].line);
-
-				next = d < next ? d : next;
-			}
-		}
-		if (next > at) {
-			break;
-		}
-		if (next > t.now) {
-			t.now = next;
-		}
-		for (int j = 0; j < MAX_NODE; j++) {
-			if (t.n[j].used && t.n[j].alive) {
-				co_line_process(&t.n[j].line, t.now);
-			}
-		}
-		settle();
-	}
-	t.now = at;
-	for (int j = 0; j < MAX_NODE; j++) {
-		if (t.n[j].used && t.n[j].alive) {
-			co_line_process(&t.n[j].line, t.now);
-		}
-	}
-	settle();
-}
-
-static void run_ms(uint64_t ms)
-{
-	run_until(t.now + ms * MS);
-}
-
 static void inject(uint16_t id, uint8_t dlc, uint8_t b0, uint8_t b1)
 {
-	struct can_frame f = {.id = id, .dlc = dlc, .data = {b0, b1}};
+	const struct can_frame f = {.id = id, .dlc = dlc, .data = {b0, b1}};
 
-	bus_put(&f, INJECTED);
-	settle();
+	co_bus_inject(&f);
 }
 
 /* --- Nodes ----------------------------------------------------------------------------------- */
@@ -230,10 +118,8 @@ static void node_add(int i, uint8_t id, const struct co_od_def *def)
 {
 	struct nd *d = &t.n[i];
 
-	d->used = true;
-	d->alive = true;
 	snprintf(d->name, sizeof(d->name), "n%02x", id);
-	co_line_init_sim(&d->line, d->name, sink, (void *)(intptr_t)i);
+	co_bus_attach(i, &d->line, d->name);
 	zassert_ok(co_node_init(&d->node, d->name, &d->line, def, &d->ram, id));
 	co_od_set_restore_cb(co_node_od(&d->node), restore, d);
 }
@@ -257,7 +143,7 @@ static uint32_t od_w(int i, uint16_t index, uint8_t sub, uint32_t v, enum co_od_
 	co_node_lock(&t.n[i].node);
 	ab = co_od_write(co_node_od(&t.n[i].node), index, sub, b, 4, who);
 	co_node_unlock(&t.n[i].node);
-	settle();
+	co_bus_settle();
 	return ab;
 }
 
@@ -270,7 +156,7 @@ static void od_w16(int i, uint16_t index, uint8_t sub, uint16_t v)
 	zassert_equal(co_od_write(co_node_od(&t.n[i].node), index, sub, b, 2, CO_OD_WRITER_APP),
 		      0U);
 	co_node_unlock(&t.n[i].node);
-	settle();
+	co_bus_settle();
 }
 
 /* Manager with a pool of @p pool COB-IDs from 6C0h; all four nodes started and settled. */
@@ -285,12 +171,12 @@ static void network(int pool)
 		cfg(MGR, 0x1F02, (uint8_t)(k + 1), POOL0 + (uint32_t)k, 4);
 	}
 	for (int i = 0; i < MAX_NODE; i++) {
-		if (t.n[i].used) {
+		if (bus.port[i].used) {
 			zassert_ok(co_node_start(&t.n[i].node));
 		}
 	}
 	/* The manager's startup resets the others (Reset Communication); let it end. */
-	run_ms(t.boot_ms != 0U ? t.boot_ms : 2000U);
+	co_bus_run_ms(t.boot_ms != 0U ? t.boot_ms : 2000U);
 }
 
 /* --- The SRD's SDO client ------------------------------------------------------------------- */
@@ -324,7 +210,7 @@ static uint32_t srd_download(uint8_t num, uint16_t index, uint8_t sub, uint32_t 
 				      CO_SDO_CLI_AUTO, 100, sdo_con, NULL);
 	co_node_unlock(n);
 	zassert_ok(err);
-	run_ms(300);
+	co_bus_run_ms(300);
 	zassert_true(sdo.done);
 	return sdo.ab;
 }
@@ -340,7 +226,7 @@ static uint32_t upload_on(int i, uint8_t num, uint16_t index, uint8_t sub, uint3
 				    CO_SDO_CLI_AUTO, 100, sdo_con, NULL);
 	co_node_unlock(n);
 	zassert_ok(err);
-	run_ms(300);
+	co_bus_run_ms(300);
 	zassert_true(sdo.done);
 	*v = sys_get_le32(sdo.buf);
 	return sdo.ab;
@@ -354,8 +240,8 @@ static uint32_t srd_upload(uint8_t num, uint16_t index, uint8_t sub, uint32_t *v
 /* Whether a frame with CAN-ID @p id was on the bus since @p since. */
 static bool seen(uint32_t id, uint64_t since)
 {
-	for (int i = 0; i < t.n_log; i++) {
-		if (t.log[i].at >= since && t.log[i].f.id == id) {
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == id) {
 			return true;
 		}
 	}
@@ -365,9 +251,9 @@ static bool seen(uint32_t id, uint64_t since)
 /* Whether an SDO download was started on CAN-ID @p id since @p since (CiA 301 ccs 1). */
 static bool seen_download(uint32_t id, uint64_t since)
 {
-	for (int i = 0; i < t.n_log; i++) {
-		if (t.log[i].at >= since && t.log[i].f.id == id &&
-		    (t.log[i].f.data[0] & 0xE0U) == 0x20U) {
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == id &&
+		    (bus.log[i].f.data[0] & 0xE0U) == 0x20U) {
 			return true;
 		}
 	}
@@ -380,7 +266,7 @@ static void srd_register(uint32_t req)
 	zassert_equal(od_w(SRD, 0x1F10, 0, req, CO_OD_WRITER_APP), 0U);
 	inject(0x6E0, 0, 0, 0);
 	/* Node-ID 7Fh is absent (scan timeout), 7Eh answers. */
-	run_ms(1000);
+	co_bus_run_ms(1000);
 }
 
 /* Connection @p k: 1F03h:01..03, then 1F04h:01..03 (the manager dictionary's sizes). */
@@ -395,7 +281,7 @@ static void node_reset(int i)
 	co_node_lock(&t.n[i].node);
 	zassert_ok(co_nmt_req(&t.n[i].node, CO_NMT_CS_RESET_COMMUNICATION));
 	co_node_unlock(&t.n[i].node);
-	settle();
+	co_bus_settle();
 }
 
 /* Frames with CAN-ID @p id since @p since. */
@@ -403,8 +289,8 @@ static int count(uint32_t id, uint64_t since)
 {
 	int n = 0;
 
-	for (int i = 0; i < t.n_log; i++) {
-		if (t.log[i].at >= since && t.log[i].f.id == id) {
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == id) {
 			n++;
 		}
 	}
@@ -417,6 +303,7 @@ static void before(void *unused)
 {
 	ARG_UNUSED(unused);
 	memset(&t, 0, sizeof(t));
+	co_bus_init();
 }
 
 /* SAFELINE_SDOM_TRACE=1 prints every frame of each test (reading a failure). */
@@ -426,11 +313,11 @@ static void after(void *unused)
 
 	ARG_UNUSED(unused);
 	if (e != NULL && e[0] == '1') {
-		for (int i = 0; i < t.n_log; i++) {
-			const struct can_frame *f = &t.log[i].f;
+		for (int i = 0; i < bus.n_log; i++) {
+			const struct can_frame *f = &bus.log[i].f;
 
 			printf("%10llu %3x [%u] %02x %02x %02x %02x %02x %02x %02x %02x\n",
-			       (unsigned long long)t.log[i].at, f->id, f->dlc, f->data[0],
+			       (unsigned long long)bus.log[i].at, f->id, f->dlc, f->data[0],
 			       f->data[1], f->data[2], f->data[3], f->data[4], f->data[5],
 			       f->data[6], f->data[7]);
 		}
@@ -446,7 +333,7 @@ ZTEST(co_mgr_sdom, test_registration)
 	uint64_t t0;
 
 	network(6);
-	t0 = t.now;
+	t0 = bus.now;
 	srd_register(0x12800001U);
 	zassert_true(seen(0x600U + 0x7FU, t0), "7Fh scanned first");
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "Rq 0, state 1, index 1280h");
@@ -461,7 +348,7 @@ ZTEST(co_mgr_sdom, test_registration)
 	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
 	zassert_equal(conn(1), ((uint32_t)ID_SRD << 16) | (1U << 8) | ID_MGR, "offsets 0 and 1");
 	/* The channel works: the SRD reads the manager's pool through 6C0h/6C1h. */
-	t0 = t.now;
+	t0 = bus.now;
 	zassert_equal(srd_upload(0, 0x1F02, 3, &v), 0U);
 	zassert_equal(v, POOL0 + 2U);
 	zassert_true(seen(POOL0, t0) && seen(POOL0 + 1U, t0));
@@ -492,7 +379,7 @@ ZTEST(co_mgr_sdom, test_connection_default_sdo)
 
 	network(6);
 	srd_register(0x12800001U);
-	t0 = t.now;
+	t0 = bus.now;
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12810006U, "state 3, index 1281h");
 	zassert_equal(od_u(SRD, 0x1281, 1), 0x600U + ID_SLV);
@@ -526,7 +413,7 @@ ZTEST(co_mgr_sdom, test_connection_dynamic)
 	zassert_equal(od_u(MGR, 0x1F02, 3), (POOL0 + 2U) | BIT(30));
 	zassert_equal(conn(3), ((uint32_t)2 << 24) | ((uint32_t)ID_SRD << 16) | (1U << 8) | ID_SLV);
 	/* The SRD really talks to S through 6C2h/6C3h. */
-	t0 = t.now;
+	t0 = bus.now;
 	zassert_equal(srd_download(2, 0x2000, 0, 0xCAFEF00DU), 0U);
 	zassert_equal(od_u(SLV, 0x2000, 0), 0xCAFEF00DU);
 	zassert_true(seen(POOL0 + 2U, t0) && seen(POOL0 + 3U, t0));
@@ -678,7 +565,7 @@ ZTEST(co_mgr_sdom, test_queue_full)
 	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0x20), CO_OD_WRITER_SDO),
 		      CO_SDO_AB_NO_RESOURCE);
 	/* All five end (error 04h each); the queue takes requests again. */
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U);
 	zassert_equal(od_w(MGR, 0x1F01, 0, REQ(0, ID_SRD, 0x20), CO_OD_WRITER_SDO), 0U);
 }
@@ -700,10 +587,10 @@ ZTEST(co_mgr_sdom, test_srd_helpers)
 	zassert_ok(co_sdom_srd_status(&srd, &st));
 	co_node_unlock(n);
 	zassert_true(st.pending);
-	t0 = t.now;
-	settle();
+	t0 = bus.now;
+	co_bus_settle();
 	zassert_true(seen(0x6E0U, t0), "the SRD sent 6E0h");
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	co_node_lock(n);
 	zassert_ok(co_sdom_srd_status(&srd, &st));
 	zassert_false(st.pending);
@@ -713,7 +600,7 @@ ZTEST(co_mgr_sdom, test_srd_helpers)
 	memset(&sdo, 0, sizeof(sdo));
 	zassert_ok(co_sdom_srd_request(&srd, 0x1281, ID_SLV, sdo_con, NULL));
 	co_node_unlock(n);
-	run_ms(300);
+	co_bus_run_ms(300);
 	zassert_true(sdo.done);
 	zassert_equal(sdo.ab, 0U);
 	co_node_lock(n);
@@ -727,7 +614,7 @@ ZTEST(co_mgr_sdom, test_srd_helpers)
 	memset(&sdo, 0, sizeof(sdo));
 	zassert_ok(co_sdom_srd_release(&srd, 0, 0, sdo_con, NULL));
 	co_node_unlock(n);
-	run_ms(300);
+	co_bus_run_ms(300);
 	zassert_equal(sdo.ab, 0U);
 	zassert_equal(conn(1), 0U);
 	zassert_equal(conn(2), 0U);
@@ -739,9 +626,9 @@ static int count_downloads(uint32_t id, uint64_t since)
 {
 	int n = 0;
 
-	for (int i = 0; i < t.n_log; i++) {
-		if (t.log[i].at >= since && t.log[i].f.id == id &&
-		    (t.log[i].f.data[0] & 0xE0U) == 0x20U) {
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == id &&
+		    (bus.log[i].f.data[0] & 0xE0U) == 0x20U) {
 			n++;
 		}
 	}
@@ -770,10 +657,10 @@ ZTEST(co_mgr_sdom, test_srd_heartbeat_lost_releases)
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "Req EC not asked, not set");
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_not_equal(conn(3), 0U, "kept while the heartbeat runs");
 	od_w16(SRD, 0x1017, 0, 0U);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	for (uint8_t k = 1U; k <= 6U; k++) {
 		zassert_equal(conn(k), 0U, "connection %u", k);
 		zassert_equal(od_u(MGR, 0x1F02, k), POOL0 + k - 1U, "1F02h:%u", k);
@@ -797,12 +684,12 @@ ZTEST(co_mgr_sdom, test_all_default_sdos_given_back_by_heartbeat)
 	network(6);
 	srd_register(0x00000003U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000004U);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	/* Still registered: a new 6E0h scan skips it, 1F10h keeps the request. */
 	srd_register(0x12800001U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800001U, "still holds the default SDOs");
 	od_w16(SRD, 0x1017, 0, 0U);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	srd_register(0x12800001U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "de-registered, registers anew");
 }
@@ -816,19 +703,19 @@ ZTEST(co_mgr_sdom, test_srd_guarded_without_heartbeat)
 	/* Guard time 100 ms, retry factor 3; bit 0 clear: no NMT slave of ours. */
 	cfg(MGR, 0x1F81, ID_SRD, (100U << 16) | (3U << 8), 4);
 	network(6);
-	t0 = t.now;
+	t0 = bus.now;
 	srd_register(0x12800001U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
-	for (int i = 0; i < t.n_log; i++) {
-		if (t.log[i].at >= t0 && t.log[i].f.id == 0x700U + ID_SRD &&
-		    (t.log[i].f.flags & CAN_FRAME_RTR) != 0U) {
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= t0 && bus.log[i].f.id == 0x700U + ID_SRD &&
+		    (bus.log[i].f.flags & CAN_FRAME_RTR) != 0U) {
 			rtr++;
 		}
 	}
 	zassert_true(rtr >= 8, "RTRs every 100 ms (%d)", rtr);
 	zassert_not_equal(conn(1), 0U, "its answers keep it");
-	t.n[SRD].alive = false;
-	run_ms(1000);
+	bus.port[SRD].alive = false;
+	co_bus_run_ms(1000);
 	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
 		      CO_SDO_AB_NO_RESOURCE, "de-registered");
 	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31), "our entry released");
@@ -848,9 +735,9 @@ ZTEST(co_mgr_sdom, test_srd_dead_entries_stale_until_bootup)
 	srd_register(0x12800001U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
-	t.n[SRD].alive = false;
-	t0 = t.now;
-	run_ms(2000);
+	bus.port[SRD].alive = false;
+	t0 = bus.now;
+	co_bus_run_ms(2000);
 	zassert_equal(count_downloads(0x600U + ID_SRD, t0), 1, "the dead SRD is asked once");
 	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31), "the slave's entry released");
 	zassert_equal(od_u(MGR, 0x1201, 1) & BIT(31), BIT(31), "our own entry released");
@@ -863,9 +750,9 @@ ZTEST(co_mgr_sdom, test_srd_dead_entries_stale_until_bootup)
 	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
 		      CO_SDO_AB_NO_RESOURCE, "de-registered");
 	/* It comes back with a reset: its entries are the defaults again, the stale ones go. */
-	t.n[SRD].alive = true;
+	bus.port[SRD].alive = true;
 	node_reset(SRD);
-	run_ms(10);
+	co_bus_run_ms(10);
 	for (uint8_t k = 1U; k <= 6U; k++) {
 		zassert_equal(conn(k), 0U, "connection %u", k);
 		zassert_equal(od_u(MGR, 0x1F02, k), POOL0 + k - 1U, "1F02h:%u", k);
@@ -883,10 +770,10 @@ ZTEST(co_mgr_sdom, test_req_ec_slave_failed)
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x1280000AU, "Req EC kept: supported");
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(od_u(SRD, 0x1F11, 0), 0U, "alive");
-	t.n[SLV].alive = false;
-	run_ms(1000);
+	bus.port[SLV].alive = false;
+	co_bus_run_ms(1000);
 	zassert_equal(od_u(SRD, 0x1F11, 0), ID_SLV, "reason 00h, slave 0Ah");
 	zassert_equal(od_u(SRD, 0x1281, 1) & BIT(31), BIT(31));
 	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31));
@@ -895,9 +782,9 @@ ZTEST(co_mgr_sdom, test_req_ec_slave_failed)
 	zassert_equal(od_u(MGR, 0x1F02, 3) & BIT(30), BIT(30));
 	zassert_not_equal(conn(1), 0U, "the SRD stays registered");
 	/* The slave boots again: its server entry is invalid, the pair is free. */
-	t.n[SLV].alive = true;
+	bus.port[SLV].alive = true;
 	node_reset(SLV);
-	run_ms(10);
+	co_bus_run_ms(10);
 	zassert_equal(conn(3), 0U);
 	zassert_equal(od_u(MGR, 0x1F02, 3), POOL0 + 2U);
 	zassert_equal(od_u(MGR, 0x1F02, 4), POOL0 + 3U);
@@ -910,14 +797,14 @@ ZTEST(co_mgr_sdom, test_release_unanswered_kept_then_retried)
 	srd_register(0x12800001U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
-	t.n[SLV].alive = false;
+	bus.port[SLV].alive = false;
 	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
-	run_ms(500);
+	co_bus_run_ms(500);
 	zassert_equal(od_u(SRD, 0x1282, 1) & BIT(31), BIT(31), "the SRD's side released");
 	zassert_not_equal(conn(3), 0U, "kept: the slave may still use the COB-IDs");
 	zassert_equal(od_u(MGR, 0x1F02, 3) & BIT(30), BIT(30));
 	/* The slave is back without a reset (it still holds the entry): the release again. */
-	t.n[SLV].alive = true;
+	bus.port[SLV].alive = true;
 	zassert_equal(od_u(SLV, 0x1201, 1), POOL0 + 2U);
 	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
 	zassert_equal(od_u(SLV, 0x1201, 1) & BIT(31), BIT(31));
@@ -939,7 +826,7 @@ ZTEST(co_mgr_sdom, test_connections_part_2)
 	zassert_not_equal(od_u(MGR, 0x1F03, 3), 0U);
 	zassert_equal(od_w(SRD2, 0x1F10, 0, 0x12800001U, CO_OD_WRITER_APP), 0U);
 	inject(0x6E0, 0, 0, 0);
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(od_u(SRD2, 0x1F10, 0), 0x12800002U);
 	zassert_equal(od_u(MGR, 0x1F04, 1), ((uint32_t)ID_SRD2 << 16) | (2U << 8) | ID_MGR,
 		      "1F04h:01, our 1202h");
@@ -963,16 +850,16 @@ ZTEST(co_mgr_sdom, test_flying_master_manager_once_active)
 	t.su = 0x21U;
 	t.boot_ms = 10U;
 	network(6);
-	t0 = t.now;
+	t0 = bus.now;
 	zassert_equal(od_w(SRD, 0x1F10, 0, 0x12800001U, CO_OD_WRITER_APP), 0U);
 	inject(0x6E0, 0, 0, 0);
-	run_ms(500);
+	co_bus_run_ms(500);
 	zassert_false(seen(0x600U + 0x7FU, t0) || seen(0x600U + ID_SRD, t0),
 		      "6E0h ignored while negotiating");
 	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO),
 		      CO_SDO_AB_DATA_DEV_STATE);
 	/* Alone, it wins within about 3 s (1F90h defaults) and serves the SRD. */
-	run_ms(5000);
+	co_bus_run_ms(5000);
 	srd_register(0x12800001U);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U);
 #endif
@@ -989,13 +876,13 @@ ZTEST(co_mgr_sdom, test_connection_waits_for_boot)
 	network(6);
 	srd_register(0x12800001U);
 	node_reset(SLV);
-	run_ms(50);
-	t0 = t.now;
+	co_bus_run_ms(50);
+	t0 = bus.now;
 	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO), 0U);
-	run_ms(200);
+	co_bus_run_ms(200);
 	zassert_equal(count(0x600U + ID_SLV, t0), 0, "no SDO manager transfer during the boot");
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12800002U, "not yet");
-	run_ms(1000);
+	co_bus_run_ms(1000);
 	zassert_equal(od_u(SRD, 0x1F10, 0), 0x12810006U, "set up once the boot ended");
 	zassert_true(seen(0x600U + ID_SLV, t0));
 }
