@@ -320,8 +320,8 @@ int co_line_stop(struct co_line *line)
 	 * SocketCAN receive thread) and may still be due for frames handed over before the
 	 * flag was set. Wait for them: frames on a working bus end within milliseconds. A bus
 	 * that does not take them (no acknowledgement) gets the controller stopped, which
-	 * aborts them (-ENETDOWN) on drivers that can; a frame even that cannot recall
-	 * (SocketCAN: the kernel holds it) leaves -EBUSY.
+	 * aborts them (-ENETDOWN) on drivers that can; a frame the driver cannot recall even
+	 * then (SocketCAN: the kernel holds it) leaves -EBUSY.
 	 */
 	int err = 0;
 
