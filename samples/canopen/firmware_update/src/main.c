@@ -33,6 +33,7 @@
 
 #include "fw_manager_od.h"
 #include "fw_slave_od.h"
+#include "pgm_offer.h"
 #include "sample_common.h"
 
 #define MANAGER  1U
@@ -56,53 +57,14 @@ static uint8_t flash_mem[2 * SLOT];
 static uint8_t img_old[CO_PGM_HDR_SIZE + BODY];
 static uint8_t img_new[CO_PGM_HDR_SIZE + BODY];
 static uint8_t img_bad[CO_PGM_HDR_SIZE + BODY];
+static struct pgm_offer offer = {.slave = SLAVE,
+				 .image = img_new,
+				 .len = sizeof(img_new),
+				 .date = NEW_DATE,
+				 .time = NEW_TIME};
 
 static K_SEM_DEFINE(booted, 0, 1);
 static uint8_t boot_status;
-
-/* A program: a header (pgm.h) and a body that stands for the machine code. */
-static void make_image(uint8_t *img, uint32_t date, uint32_t time, uint8_t seed)
-{
-	for (uint32_t i = 0; i < BODY; i++) {
-		img[CO_PGM_HDR_SIZE + i] = (uint8_t)(seed * 31U + i * 13U + (i >> 8));
-	}
-	co_pgm_image_header(img, img + CO_PGM_HDR_SIZE, BODY, date, time);
-}
-
-static void mgr_restore(struct co_od *od, uint32_t group_mask, void *user_data)
-{
-	const struct {
-		uint16_t index;
-		uint8_t sub;
-		uint32_t value;
-	} cfg[] = {
-		{0x1F80, 0, 0x01},     /* NMT master */
-		{0x1F81, SLAVE, 0x65}, /* slave, boot, check software (5), update allowed (6) */
-		{0x1F53, SLAVE, NEW_DATE},
-		{0x1F54, SLAVE, NEW_TIME},
-	};
-
-	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) == 0U) {
-		return;
-	}
-	for (size_t i = 0; i < ARRAY_SIZE(cfg); i++) {
-		uint8_t buf[4];
-
-		sys_put_le32(cfg[i].value, buf);
-		(void)co_od_write(od, cfg[i].index, cfg[i].sub, buf, 4, CO_OD_WRITER_STORAGE);
-	}
-}
-
-static int image_source(struct co_node *node, uint8_t id, const void **image, size_t *len,
-			void *user_data)
-{
-	if (id != SLAVE) {
-		return -ENOENT;
-	}
-	*image = img_new;
-	*len = sizeof(img_new);
-	return 0;
-}
 
 static void boot_ind(struct co_node *node, uint8_t id, uint8_t status,
 		     const struct co_mgr_boot_error *err, void *user_data)
@@ -172,8 +134,8 @@ int main(void)
 		printk("firmware_update: no CAN controller\n");
 		return 1;
 	}
-	make_image(img_old, OLD_DATE, OLD_TIME, 1);
-	make_image(img_new, NEW_DATE, NEW_TIME, 2);
+	pgm_offer_make_image(img_old, BODY, OLD_DATE, OLD_TIME, 1);
+	pgm_offer_make_image(img_new, BODY, NEW_DATE, NEW_TIME, 2);
 	memcpy(img_bad, img_new, sizeof(img_bad));
 	img_bad[CO_PGM_HDR_SIZE + BODY / 2] ^= 0x04; /* one bit flipped in transit */
 
@@ -201,9 +163,9 @@ int main(void)
 	(void)co_pgm_get_running(&slave, &info, &slot);
 	printk("slave: boots program date %u time %u from slot %d\n", info.date, info.time, slot);
 	co_pgm_set_ind(&slave, pgm_ind, NULL);
-	co_od_set_restore_cb(co_node_od(&mgr), mgr_restore, NULL);
+	co_od_set_restore_cb(co_node_od(&mgr), pgm_offer_restore, &offer);
 	co_mgr_set_boot_ind(&mgr, boot_ind, NULL);
-	co_mgr_set_pgm_source(&mgr, image_source, NULL);
+	co_mgr_set_pgm_source(&mgr, pgm_offer_source, &offer);
 	printk("manager: node 2 has program date %u time %u, expected date %u time %u\n", info.date,
 	       info.time, NEW_DATE, NEW_TIME);
 

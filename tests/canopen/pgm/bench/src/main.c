@@ -43,6 +43,8 @@
 #include "pgm_master_od.h"
 #include "pgm_slave_od.h"
 
+#include "pgm_offer.h"
+
 #define MANAGER  1U
 #define SLAVE    2U
 #define IMAGE    (256U * 1024U) /* bytes on the wire: header and body */
@@ -71,49 +73,15 @@ static uint8_t flash_mem[2 * SLOT];
 static uint8_t img[2][IMAGE];
 static const uint32_t img_date[2] = {14000U, 15000U};
 static const uint32_t img_time[2] = {3600000U, 7200000U};
-static int target; /* the image this round installs; read under the manager's lock */
+static int target;             /* the image this round installs */
+static struct pgm_offer offer; /* img[target]; changed under the manager's lock */
 
 static K_SEM_DEFINE(boot_sem, 0, 1);
 static uint8_t boot_status;
 static struct co_mgr_boot_error boot_err;
 static uint64_t boot_end_us;
 
-/* --- The manager's configuration and image source ----------------------------------------- */
-
-static void mgr_restore(struct co_od *od, uint32_t group_mask, void *user_data)
-{
-	const struct {
-		uint16_t index;
-		uint8_t sub;
-		uint32_t value;
-	} cfg[] = {
-		{0x1F80, 0, 0x01},     /* NMT master */
-		{0x1F81, SLAVE, 0x65}, /* slave, boot, check software (5), update allowed (6) */
-		{0x1F53, SLAVE, img_date[target]},
-		{0x1F54, SLAVE, img_time[target]},
-	};
-
-	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) == 0U) {
-		return;
-	}
-	for (size_t i = 0; i < ARRAY_SIZE(cfg); i++) {
-		uint8_t buf[4];
-
-		sys_put_le32(cfg[i].value, buf);
-		(void)co_od_write(od, cfg[i].index, cfg[i].sub, buf, 4, CO_OD_WRITER_STORAGE);
-	}
-}
-
-static int source(struct co_node *node, uint8_t id, const void **image, size_t *len,
-		  void *user_data)
-{
-	if (id != SLAVE) {
-		return -ENOENT;
-	}
-	*image = img[target];
-	*len = IMAGE;
-	return 0;
-}
+/* --- The manager's boot indication --------------------------------------------------------- */
 
 static void boot_ind(struct co_node *node, uint8_t id, uint8_t status,
 		     const struct co_mgr_boot_error *err, void *user_data)
@@ -301,6 +269,11 @@ static void round_run(int r, struct run *out)
 
 	co_node_lock(&mgr);
 	target = (r + 1) % 2;
+	offer = (struct pgm_offer){.slave = SLAVE,
+				   .image = img[target],
+				   .len = IMAGE,
+				   .date = img_date[target],
+				   .time = img_time[target]};
 	co_node_unlock(&mgr);
 	memset(&watch, 0, sizeof(watch));
 	watch.on = true;
@@ -359,9 +332,9 @@ int main(void)
 	    co_pgm_attach(&slave, &flash.flash) != 0) {
 		fail("set-up failed");
 	}
-	co_od_set_restore_cb(co_node_od(&mgr), mgr_restore, NULL);
+	co_od_set_restore_cb(co_node_od(&mgr), pgm_offer_restore, &offer);
 	co_mgr_set_boot_ind(&mgr, boot_ind, NULL);
-	co_mgr_set_pgm_source(&mgr, source, NULL);
+	co_mgr_set_pgm_source(&mgr, pgm_offer_source, &offer);
 	spy = device_get_binding("can_virtual2");
 	if (spy == NULL || can_start(spy) != 0 ||
 	    can_add_rx_filter(spy, spy_rx, NULL, &(struct can_filter){.id = 0, .mask = 0}) < 0) {

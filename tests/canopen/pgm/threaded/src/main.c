@@ -34,6 +34,8 @@
 #include "pgm_master_od.h"
 #include "pgm_slave_od.h"
 
+#include "pgm_offer.h"
+
 #define MANAGER    1U
 #define SLAVE      2U
 #define BODY       (16U * 1024U)
@@ -77,6 +79,8 @@ static K_THREAD_STACK_DEFINE(mstack, CONFIG_CANOPEN_LINE_STACK_SIZE);
 static K_THREAD_STACK_DEFINE(sstack, CONFIG_CANOPEN_LINE_STACK_SIZE);
 
 static uint8_t img_old[IMAGE], img_new[IMAGE];
+static struct pgm_offer offer = {
+	.slave = SLAVE, .image = img_new, .len = IMAGE, .date = NEW_DATE, .time = NEW_TIME};
 
 /* The slave's flash: a RAM flash that counts the bytes of the download and cuts there. */
 static struct {
@@ -150,41 +154,6 @@ static void slave_reset(struct co_node *node, enum co_nmt_cs cs, void *user_data
 
 /* --- The manager ----------------------------------------------------------------------------- */
 
-static void mgr_restore(struct co_od *od, uint32_t group_mask, void *user_data)
-{
-	const struct {
-		uint16_t index;
-		uint8_t sub;
-		uint32_t value;
-	} cfg[] = {
-		{0x1F80, 0, 0x01},     /* NMT master */
-		{0x1F81, SLAVE, 0x65}, /* slave, boot, check software (5), update allowed (6) */
-		{0x1F53, SLAVE, NEW_DATE},
-		{0x1F54, SLAVE, NEW_TIME},
-	};
-
-	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) == 0U) {
-		return;
-	}
-	for (size_t i = 0; i < ARRAY_SIZE(cfg); i++) {
-		uint8_t buf[4];
-
-		sys_put_le32(cfg[i].value, buf);
-		(void)co_od_write(od, cfg[i].index, cfg[i].sub, buf, 4, CO_OD_WRITER_STORAGE);
-	}
-}
-
-static int source(struct co_node *node, uint8_t id, const void **image, size_t *len,
-		  void *user_data)
-{
-	if (id != SLAVE) {
-		return -ENOENT;
-	}
-	*image = img_new;
-	*len = sizeof(img_new);
-	return 0;
-}
-
 static void boot_ind(struct co_node *node, uint8_t id, uint8_t status,
 		     const struct co_mgr_boot_error *err, void *user_data)
 {
@@ -204,9 +173,9 @@ static void manager_up(void)
 	k_sem_reset(&boot_sem);
 	zassert_ok(co_line_init(mline, "mline", mdev));
 	zassert_ok(co_node_init(&mgr, "manager", mline, &pgm_master_od_def, &mram, MANAGER));
-	co_od_set_restore_cb(co_node_od(&mgr), mgr_restore, NULL);
+	co_od_set_restore_cb(co_node_od(&mgr), pgm_offer_restore, &offer);
 	co_mgr_set_boot_ind(&mgr, boot_ind, NULL);
-	co_mgr_set_pgm_source(&mgr, source, NULL);
+	co_mgr_set_pgm_source(&mgr, pgm_offer_source, &offer);
 	zassert_ok(co_line_start(mline, mstack, K_THREAD_STACK_SIZEOF(mstack),
 				 CONFIG_CANOPEN_LINE_THREAD_PRIORITY));
 	zassert_ok(co_node_start(&mgr));
@@ -223,22 +192,14 @@ static void manager_gone(void)
 /* --- Set-up ------------------------------------------------------------------------------------
  */
 
-static void make_image(uint8_t *img, uint32_t date, uint32_t time, uint8_t seed)
-{
-	for (uint32_t i = 0; i < BODY; i++) {
-		img[CO_PGM_HDR_SIZE + i] = (uint8_t)(seed * 31U + i * 13U + (i >> 8));
-	}
-	co_pgm_image_header(img, img + CO_PGM_HDR_SIZE, BODY, date, time);
-}
-
 static void *suite_setup(void)
 {
 	mdev = device_get_binding("can_virtual0");
 	sdev = device_get_binding("can_virtual1");
 	zassert_not_null(mdev);
 	zassert_not_null(sdev);
-	make_image(img_old, OLD_DATE, OLD_TIME, 1);
-	make_image(img_new, NEW_DATE, NEW_TIME, 2);
+	pgm_offer_make_image(img_old, BODY, OLD_DATE, OLD_TIME, 1);
+	pgm_offer_make_image(img_new, BODY, NEW_DATE, NEW_TIME, 2);
 	return NULL;
 }
 
