@@ -37,13 +37,14 @@
 #include "fm_manager_od.h"
 #include "fm_slave_od.h"
 #include "posix_native_task.h"
+#include "hb_options.h"
 #include "sample_common.h"
 
 #define N_MGR   2
 #define N_SLAVE 3
 
 /* 1F90h defaults: master timeout 100 ms, delay 500 ms, slots 1500/10 ms. */
-#define BOUND_MS(prio, id) (opt.consumer_ms + 500U + 100U + (prio) * 1500U + (id) * 10U)
+#define BOUND_MS(prio, id) (hb_opt.consumer_ms + 500U + 100U + (prio) * 1500U + (id) * 10U)
 
 static const uint8_t mgr_id[N_MGR] = {3, 2};
 static const uint8_t mgr_prio[N_MGR] = {0, 1};
@@ -54,20 +55,8 @@ static const uint8_t slave_id[N_SLAVE] = {10, 11, 12};
  * other), --nodes (which of the five nodes run here; bit i: mgr[i], bit 2 + s: slave[s]).
  */
 static struct {
-	uint32_t hb_ms;
-	uint32_t consumer_ms;
 	uint32_t nodes;
-} opt = {.hb_ms = 100U, .consumer_ms = 300U, .nodes = 0x1FU};
-
-static void hb_found(char *argv, int offset)
-{
-	opt.hb_ms = (uint32_t)cmd_read_uint_option("hb", &argv[offset], 1U, 65535U);
-}
-
-static void consumer_found(char *argv, int offset)
-{
-	opt.consumer_ms = (uint32_t)cmd_read_uint_option("hb-consumer", &argv[offset], 1U, 65535U);
-}
+} opt = {.nodes = 0x1FU};
 
 /* The bit of node @p id in opt.nodes, 0 if it is none of the sample's nodes. */
 static uint32_t node_bit(unsigned long id)
@@ -112,21 +101,9 @@ static void nodes_found(char *argv, int offset)
 static void add_options(void)
 {
 	static struct args_struct_t opts[] = {
-		{
-			.option = "hb",
-			.name = "ms",
-			.type = 'u',
-			.call_when_found = hb_found,
-			.descript = "heartbeat period of every node, 1017h (default 100)",
-		},
-		{
-			.option = "hb-consumer",
-			.name = "ms",
-			.type = 'u',
-			.call_when_found = consumer_found,
-			.descript = "consumer time of the candidates' 1016h entry for each other "
-				    "(default 300)",
-		},
+		HB_OPTIONS("heartbeat period of every node, 1017h (default 100)",
+			   "consumer time of the candidates' 1016h entry for each other "
+			   "(default 300)"),
 		{
 			.option = "nodes",
 			.name = "id,id,...",
@@ -144,13 +121,7 @@ NATIVE_TASK(add_options, PRE_BOOT_1, 21);
 
 static void check_options(void)
 {
-	char value[16];
-
-	if (opt.consumer_ms <= opt.hb_ms) {
-		(void)snprintf(value, sizeof(value), "%u", opt.consumer_ms);
-		cmd_option_error("hb-consumer", value, "must be longer than the heartbeat (%u ms)",
-				 opt.hb_ms);
-	}
+	hb_options_check(100U, 300U);
 }
 NATIVE_TASK(check_options, PRE_BOOT_2, 0);
 
@@ -196,10 +167,10 @@ static void mgr_restore(struct co_od *od, uint32_t group_mask, void *user_data)
 	}
 	put(od, 0x1F80, 0, 0x21, 4); /* NMT master, flying master */
 	put(od, 0x1F90, 3, mgr_prio[i], 2);
-	put(od, 0x1017, 0, opt.hb_ms, 2);
+	put(od, 0x1017, 0, hb_opt.hb_ms, 2);
 	put(od, 0x1029, 1, 1, 1); /* the manager handles lost heartbeats, not 1029h */
 	/* The other candidate is a slave of whoever wins; its heartbeat is watched. */
-	put(od, 0x1016, 1, ((uint32_t)other << 16) | opt.consumer_ms, 4);
+	put(od, 0x1016, 1, ((uint32_t)other << 16) | hb_opt.consumer_ms, 4);
 	put(od, 0x1F81, other, 0x05, 4);
 	for (int s = 0; s < N_SLAVE; s++) {
 		put(od, 0x1F81, slave_id[s], 0x05, 4); /* slave, boot */
@@ -211,7 +182,7 @@ static void slave_restore(struct co_od *od, uint32_t group_mask, void *user_data
 {
 	ARG_UNUSED(user_data);
 	if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) != 0U) {
-		put(od, 0x1017, 0, opt.hb_ms, 2);
+		put(od, 0x1017, 0, hb_opt.hb_ms, 2);
 	}
 }
 

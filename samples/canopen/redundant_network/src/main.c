@@ -42,6 +42,7 @@
 #include <canopen/redundancy.h>
 
 #include "cmdline.h"
+#include "hb_options.h"
 #include "link.h"
 #include "posix_native_task.h"
 #include "rdn_master_od.h"
@@ -65,16 +66,9 @@ static struct {
 	double settle_s;
 	double cut_s;
 	double pause_s;
-	uint32_t hb_ms;
-	uint32_t consumer_ms;
 	uint32_t pdo_ms;
 } opt = {
-	.settle_s = 0.5,
-	.cut_s = 1.0,
-	.pause_s = 1.0,
-	.hb_ms = 0U,       /* 0: the dictionaries' 1017h */
-	.consumer_ms = 0U, /* 0: the dictionaries' 1016h */
-	.pdo_ms = 0U,      /* 0: the slaves' 1800h:05 */
+	.settle_s = 0.5, .cut_s = 1.0, .pause_s = 1.0, .pdo_ms = 0U, /* 0: the slaves' 1800h:05 */
 };
 
 static void settle_found(char *argv, int offset)
@@ -90,16 +84,6 @@ static void cut_found(char *argv, int offset)
 static void pause_found(char *argv, int offset)
 {
 	opt.pause_s = cmd_read_double_option("pause", &argv[offset], 0.01, 3600.0);
-}
-
-static void hb_found(char *argv, int offset)
-{
-	opt.hb_ms = (uint32_t)cmd_read_uint_option("hb", &argv[offset], 1U, 65535U);
-}
-
-static void consumer_found(char *argv, int offset)
-{
-	opt.consumer_ms = (uint32_t)cmd_read_uint_option("hb-consumer", &argv[offset], 1U, 65535U);
 }
 
 static void pdo_found(char *argv, int offset)
@@ -132,22 +116,9 @@ static void add_options(void)
 			.call_when_found = pause_found,
 			.descript = "how long both lines run after a restore (default 1)",
 		},
-		{
-			.option = "hb",
-			.name = "ms",
-			.type = 'u',
-			.call_when_found = hb_found,
-			.descript = "heartbeat period of every node, 1017h (default: the "
-				    "dictionaries', 50)",
-		},
-		{
-			.option = "hb-consumer",
-			.name = "ms",
-			.type = 'u',
-			.call_when_found = consumer_found,
-			.descript = "heartbeat consumer time of every 1016h entry (default: the "
-				    "dictionaries', 125)",
-		},
+		HB_OPTIONS("heartbeat period of every node, 1017h (default: the dictionaries', 50)",
+			   "heartbeat consumer time of every 1016h entry (default: the "
+			   "dictionaries', 125)"),
 		{
 			.option = "pdo-ms",
 			.name = "ms",
@@ -165,13 +136,8 @@ NATIVE_TASK(add_options, PRE_BOOT_1, 21);
 
 static void check_options(void)
 {
-	char value[16];
-
-	if (opt.hb_ms != 0U && opt.consumer_ms != 0U && opt.consumer_ms <= opt.hb_ms) {
-		(void)snprintf(value, sizeof(value), "%u", opt.consumer_ms);
-		cmd_option_error("hb-consumer", value, "must be longer than the heartbeat (%u ms)",
-				 opt.hb_ms);
-	}
+	/* 0: the dictionaries' 1017h and 1016h stay. */
+	hb_options_check(0U, 0U);
 }
 NATIVE_TASK(check_options, PRE_BOOT_2, 21);
 
@@ -311,18 +277,18 @@ static int apply_timings(struct unit *u)
 	int err = 0;
 	uint8_t n = u == MASTER ? N_SLAVES : 1U;
 
-	if (opt.hb_ms != 0U) {
+	if (hb_opt.hb_ms != 0U) {
 		co_node_lock(&u->node);
-		if (co_od_set_u16(co_node_od(&u->node), IDX_HB_PROD, 0, (uint16_t)opt.hb_ms,
+		if (co_od_set_u16(co_node_od(&u->node), IDX_HB_PROD, 0, (uint16_t)hb_opt.hb_ms,
 				  CO_OD_WRITER_APP) != 0U) {
 			err = -EIO;
 		}
 		co_node_unlock(&u->node);
 	}
-	for (uint8_t sub = 1; err == 0 && opt.consumer_ms != 0U && sub <= n; sub++) {
+	for (uint8_t sub = 1; err == 0 && hb_opt.consumer_ms != 0U && sub <= n; sub++) {
 		uint32_t e = get_u32(u, IDX_HB_CONS, sub);
 
-		err = set_u32(u, IDX_HB_CONS, sub, (e & 0xFFFF0000U) | opt.consumer_ms);
+		err = set_u32(u, IDX_HB_CONS, sub, (e & 0xFFFF0000U) | hb_opt.consumer_ms);
 	}
 	if (err == 0 && opt.pdo_ms != 0U && u != MASTER) {
 		co_node_lock(&u->node);
