@@ -969,6 +969,7 @@ static void tpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void
 	}
 }
 
+#if defined(CONFIG_CANOPEN_PDO_DYNAMIC_MAPPING)
 static uint32_t map_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_node *node = user_data;
@@ -1047,6 +1048,15 @@ static void map_notify(struct co_od *od, const struct co_od_req *req, void *user
 		cos_hooks_update(t);
 	}
 }
+#define MAP_NOTIFY map_notify
+#else /* !CONFIG_CANOPEN_PDO_DYNAMIC_MAPPING */
+/* Static mapping: a restore from storage takes effect at the next reset of communication. */
+static uint32_t map_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	return req->writer == CO_OD_WRITER_STORAGE ? 0U : CO_SDO_AB_READONLY;
+}
+#define MAP_NOTIFY NULL
+#endif /* CONFIG_CANOPEN_PDO_DYNAMIC_MAPPING */
 
 /* --- Node interface ----------------------------------------------------------------------- */
 
@@ -1074,7 +1084,7 @@ static const struct co_od_hook pdo_hooks[] = {
 		.sub_first = 0,
 		.sub_last = MAP_MAX,
 		.validate = map_validate,
-		.notify = map_notify,
+		.notify = MAP_NOTIFY,
 	},
 	{
 		.index_first = IDX_TPDO_COMM,
@@ -1088,7 +1098,7 @@ static const struct co_od_hook pdo_hooks[] = {
 		.sub_first = 0,
 		.sub_last = MAP_MAX,
 		.validate = map_validate,
-		.notify = map_notify,
+		.notify = MAP_NOTIFY,
 	},
 };
 
