@@ -376,6 +376,8 @@ struct co_mgr_sdom {
 	bool wait;         /* a step waits for a slave's boot to leave its default SDO */
 	uint8_t up_node, up_sub;
 	uint16_t up_index; /* the upload that waits */
+	uint8_t busy_node; /* node whose default SDO our transfer uses now, 0: none */
+	uint32_t ecmap[4]; /* node-IDs supervised because an SRD asked for Req EC */
 };
 /** @endcond */
 #endif /* CONFIG_CANOPEN_MGR_SDOM */
@@ -435,6 +437,7 @@ struct co_mgr_slave {
 	bool cfg_wait;       /* DOWNLOAD step waiting for a configuration job slot */
 	bool await_bootup;   /* reset by the master, no boot-up seen since */
 	bool held;           /* an attempt waits for the master to leave Stopped */
+	bool sdo_wait;       /* an SDO step waits for the default SDO (mgr_sdom.c) */
 	/* Two lines: BIT(line) whose loss was reported (CO_HB_EV_LINE_LOST). */
 	uint8_t line_lost;
 	/* Two lines: the last heartbeat on each, or the start of monitoring. */

@@ -40,6 +40,9 @@ BUILD_ASSERT(CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES,
  */
 #define CFG_WAIT_POLL_MS 100U
 
+/* A step that waits for the slave's default SDO (held by an SRD) looks again after [ms]. */
+#define SDO_WAIT_POLL_MS 10U
+
 /* "load" (CiA 301 1011h) on the wire. */
 static const uint8_t sig_load[4] = {'l', 'o', 'a', 'd'};
 
@@ -711,6 +714,7 @@ static void boot_end(struct co_mgr_slave *s)
 	uint64_t now = co_mgr_now(m);
 
 	s->booting = false;
+	s->sdo_wait = false;
 	s->tried = true;
 	s->finished_us = now;
 	s->step = CO_MGR_STEP_IDLE;
@@ -746,6 +750,22 @@ static void boot_end(struct co_mgr_slave *s)
 	co_mgr_startup_boot_ended(s, mandatory, now);
 }
 
+/*
+ * Whether the step about to start must wait for the slave's default SDO: an SRD holds it
+ * (302 §7.1: the SDO manager lends the default SDO to one client at a time) or our SDO
+ * manager's own transfer to the slave runs.
+ */
+static bool sdo_held(struct co_mgr_slave *s, uint8_t step)
+{
+#if defined(CONFIG_CANOPEN_MGR_SDOM)
+	return boot_table[step].sdo != NULL && co_mgr_sdom_default_held(s->mgr, s->id);
+#else
+	ARG_UNUSED(s);
+	ARG_UNUSED(step);
+	return false;
+#endif
+}
+
 static void boot_run(struct co_mgr_slave *s, uint8_t next)
 {
 	while (next != NEXT_WAIT) {
@@ -754,6 +774,18 @@ static void boot_run(struct co_mgr_slave *s, uint8_t next)
 			return;
 		}
 		s->step = next;
+		if (sdo_held(s, next)) {
+			/* Looked at again by the slave's timer; 1F89h keeps running meanwhile. */
+			if (!s->sdo_wait) {
+				LOG_INF("%s: boot of node %u waits in %s: its default SDO is held",
+					s->mgr->node->name, s->id,
+					co_mgr_step_str((enum co_mgr_step)s->step));
+			}
+			s->sdo_wait = true;
+			co_mgr_arm(s, SDO_WAIT_POLL_MS);
+			return;
+		}
+		s->sdo_wait = false;
 		next = boot_table[next].enter(s);
 	}
 }
@@ -827,6 +859,7 @@ static void boot_attempt(struct co_mgr_slave *s)
 	s->wait_reboot = false;
 	s->start_deferred = false;
 	s->cfg_wait = false;
+	s->sdo_wait = false;
 	/* The working record; co_mgr_get_boot() shows the last finished one until boot_end(). */
 	memset(&s->err, 0, sizeof(s->err));
 	memset(s->ident, 0, sizeof(s->ident));
@@ -866,6 +899,7 @@ void co_mgr_boot_expire(struct co_mgr_slave *s, uint64_t now_us)
 			   0U, 0U);
 		s->booting = false;
 		s->cfg_wait = false;
+		s->sdo_wait = false;
 		s->step = CO_MGR_STEP_IDLE;
 		s->finished_us = now_us;
 		publish(s);
@@ -921,6 +955,11 @@ void co_mgr_slave_timer_handler(struct co_timer *timer, uint64_t now_us)
 {
 	struct co_mgr_slave *s = timer->user_data;
 
+	if (s->booting && s->sdo_wait) {
+		/* The step that waited for the default SDO: try it again. */
+		boot_run(s, s->step);
+		return;
+	}
 	if (s->booting) {
 		if (boot_table[s->step].timeout != NULL) {
 			boot_run(s, boot_table[s->step].timeout(s));

@@ -256,6 +256,10 @@ int co_mgr_sdom_init(struct co_mgr *m);
 void co_mgr_sdom_lost(struct co_mgr *m, uint8_t id);
 /* Node @p id sent its boot-up: entries it kept after a failed release are gone. */
 void co_mgr_sdom_bootup(struct co_mgr *m, uint8_t id);
+/* Whether the boot of @p id must not use its default SDO now: an SRD holds it (a connection
+ * over it, or all default SDOs), or our own SDO manager transfer to @p id runs.
+ */
+bool co_mgr_sdom_default_held(struct co_mgr *m, uint8_t id);
 #endif
 
 #endif /* SAFELINE_SUBSYS_CANOPEN_MGR_MGR_INTERNAL_H_ */

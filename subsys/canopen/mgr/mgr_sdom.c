@@ -265,12 +265,28 @@ static void bit_set(uint32_t *map, uint8_t id, bool on)
 	}
 }
 
-/* Whether the boot process of @p id runs: its default SDO belongs to the boot (302 §7.1). */
+/*
+ * Whether the boot process of @p id uses its default SDO (302 §7.1: it belongs to the boot
+ * then). A boot that waits for an SRD to give the default SDO back does not use it.
+ */
 static bool booting(struct co_mgr *m, uint8_t id)
 {
 	struct co_mgr_slave *s = co_mgr_slot_find(m, id);
 
-	return s != NULL && s->booting;
+	return s != NULL && s->booting && !s->sdo_wait;
+}
+
+/* Whether a boot of a node other than @p srd uses its default SDO now. */
+static bool any_booting(struct co_mgr *m, uint8_t srd)
+{
+	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+		const struct co_mgr_slave *s = &m->slaves[i];
+
+		if (s->id != 0U && s->id != srd && booting(m, s->id)) {
+			return true;
+		}
+	}
+	return false;
 }
 
 /* Look again once the boot had time to go on; the step is taken up by work_handler(). */
@@ -320,14 +336,49 @@ static void supervise(struct co_mgr *m, uint8_t id)
 	}
 }
 
-/* A de-registered SRD that is no NMT slave of ours leaves its slot. */
+/* Whether an SRD with Req EC still has a connection to @p id (one that was not released). */
+static bool reqec_conn_to(struct co_mgr *m, uint8_t id)
+{
+	uint8_t n = conn_count(m);
+
+	for (uint8_t i = 1U; i <= n; i++) {
+		uint32_t c = conn_get(m, i);
+		int k = srd_find(m, (uint8_t)(c >> 16));
+
+		if ((uint8_t)c == id && k >= 0 && m->sdom.reqec[k] && m->sdom.stale[i - 1U] == 0U) {
+			return true;
+		}
+	}
+	return false;
+}
+
+/*
+ * Node @p id lost a reason to be supervised by us (de-registered as an SRD, or the last
+ * connection of an SRD with Req EC to it ended): its supervision stops and it leaves its
+ * slot, unless another reason remains: an NMT slave of ours (its boot owns its error
+ * control), a registered SRD, or a slave of a Req EC connection.
+ */
 static void unsupervise(struct co_mgr *m, uint8_t id)
 {
 	struct co_mgr_slave *s = co_mgr_slot_find(m, id);
 
-	if (s != NULL && (co_mgr_assign(m, id) & AS_SLAVE) == 0U && !s->booting) {
+	if (s != NULL && (co_mgr_assign(m, id) & AS_SLAVE) == 0U && !s->booting &&
+	    srd_find(m, id) < 0 && !reqec_conn_to(m, id)) {
 		co_mgr_ec_stop(s);
 		s->id = 0U;
+	}
+}
+
+/* Slaves supervised for Req EC whose last such connection ended (302 §7.2.2). */
+static void ec_review(struct co_mgr *m)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	for (uint8_t id = 1U; id <= 127U; id++) {
+		if (bit_get(d->ecmap, id) && !reqec_conn_to(m, id)) {
+			bit_set(d->ecmap, id, false);
+			unsupervise(m, id);
+		}
 	}
 }
 
@@ -350,7 +401,9 @@ static void start_upload(struct co_mgr *m, uint8_t node, uint16_t index, uint8_t
 		/* Answered from the timer as a failed upload: no call back into con() here. */
 		d->fake_ab = CO_SDO_AB_GENERAL;
 		kick(m);
+		return;
 	}
+	d->busy_node = node;
 }
 
 static void step_write(struct co_mgr *m)
@@ -367,7 +420,12 @@ static void step_write(struct co_mgr *m)
 			d->i_wr++;
 			continue;
 		}
-		if (w->node != own_id(m) && booting(m, w->node)) {
+		/*
+		 * "All default SDOs" is confirmed once no running boot uses one: a boot's
+		 * transfer is not overlapped by the SRD's (boots that wait for it do not count).
+		 */
+		if ((w->node != own_id(m) && booting(m, w->node)) ||
+		    (d->end == END_ALL && any_booting(m, d->srd))) {
 			wait_boot(m);
 			return;
 		}
@@ -387,6 +445,7 @@ static void step_write(struct co_mgr *m)
 			d->i_wr++;
 			continue;
 		}
+		d->busy_node = w->node;
 		return;
 	}
 	if (d->end == END_REL && d->fail_side == 0U) {
@@ -405,10 +464,12 @@ static void step_write(struct co_mgr *m)
 	} else if (d->end == END_CONN && srd_find(m, d->srd) >= 0 &&
 		   d->reqec[srd_find(m, d->srd)]) {
 		/* 302 §7.2.2: the SRD asked for error control of its slaves. */
+		bit_set(d->ecmap, d->slave, true);
 		supervise(m, d->slave);
 	} else {
 		/* A failure status written: nothing follows. */
 	}
+	ec_review(m);
 	d->op = OP_NONE;
 	kick(m);
 }
@@ -540,8 +601,12 @@ static void registered(struct co_mgr *m, uint8_t id, uint32_t v)
 		d->reqec[slot] = false;
 		d->srd = id;
 		/* Nothing to set up: the SRD uses the default SDOs (state 2). */
-		status_only(m, id, ST_STATE(2));
+		d->n_wr = 0U;
+		d->i_wr = 0U;
 		d->end = END_ALL;
+		add_status(m, id, ST_STATE(2));
+		d->op = OP_WRITE;
+		step_write(m);
 		return;
 	}
 	for (uint8_t n = 1U; n < 128U && srv == 0U; n++) {
@@ -609,6 +674,7 @@ static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data)
 	uint32_t v = sys_get_le32(d->buf);
 
 	ARG_UNUSED(c);
+	d->busy_node = 0U;
 	switch (d->op) {
 	case OP_SCAN:
 		/* 302 §7.2.1: the first SRD with Rq indication set ends the scan. */
@@ -828,6 +894,7 @@ static void next(struct co_mgr *m)
 					d->all[i] = false;
 					d->reqec[i] = false;
 					unsupervise(m, (uint8_t)(d->rel_val >> 8));
+					ec_review(m);
 				}
 			}
 			continue;
@@ -991,6 +1058,22 @@ static void work_handler(struct co_timer *timer, uint64_t now_us)
 		return;
 	}
 	next(m);
+}
+
+bool co_mgr_sdom_default_held(struct co_mgr *m, uint8_t id)
+{
+	struct co_mgr_sdom *d = &m->sdom;
+
+	if (d->busy_node == id || default_taken(m, id)) {
+		return true;
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_MGR_SDOM_SRDS; i++) {
+		/* An SRD with all default SDOs: every one but its own. */
+		if (d->srds[i] != 0U && d->srds[i] != id && d->all[i]) {
+			return true;
+		}
+	}
+	return false;
 }
 
 void co_mgr_sdom_lost(struct co_mgr *m, uint8_t id)

@@ -887,4 +887,188 @@ ZTEST(co_mgr_sdom, test_connection_waits_for_boot)
 	zassert_true(seen(0x600U + ID_SLV, t0));
 }
 
+/* Node guarding RTRs on 700h + @p id since @p since. */
+static int count_rtr(uint8_t id, uint64_t since)
+{
+	int n = 0;
+
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == 0x700U + id &&
+		    (bus.log[i].f.flags & CAN_FRAME_RTR) != 0U) {
+			n++;
+		}
+	}
+	return n;
+}
+
+/* Whether the NMT master sent "start" (000#01nn) to @p id since @p since. */
+static bool seen_start(uint8_t id, uint64_t since)
+{
+	for (int i = 0; i < bus.n_log; i++) {
+		if (bus.log[i].at >= since && bus.log[i].f.id == 0U &&
+		    bus.log[i].f.data[0] == 0x01U && bus.log[i].f.data[1] == id) {
+			return true;
+		}
+	}
+	return false;
+}
+
+/* SDO uploads of @p index started on CAN-ID @p id since @p since (ccs 2). */
+static int count_uploads(uint32_t id, uint16_t index, uint64_t since)
+{
+	int n = 0;
+
+	for (int i = 0; i < bus.n_log; i++) {
+		const struct can_frame *f = &bus.log[i].f;
+
+		if (bus.log[i].at >= since && f->id == id && (f->data[0] & 0xE0U) == 0x40U &&
+		    sys_get_le16(&f->data[1]) == index) {
+			n++;
+		}
+	}
+	return n;
+}
+
+/*
+ * The boot of a slave whose default SDO an SRD holds (a connection over it) waits: none of
+ * its transfers goes out on 600h + S until the connection is released, then it runs to the
+ * end (NMT start). The release writes the slave's dynamic entry first, over its default SDO:
+ * a boot that waits does not hold that write up.
+ */
+ZTEST(co_mgr_sdom, test_boot_waits_for_srd_default_connection)
+{
+	uint64_t t0;
+
+	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
+	network(6);
+	srd_register(0x12800001U);
+	/* Connection 3 over S's default SDO, then connection 2 dynamic to S (its 1201h). */
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_PLAIN)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1281, ID_SRD, ID_PLAIN)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(od_u(SRD, 0x1282, 1), 0x600U + ID_SLV, "over the default SDO");
+	zassert_equal(conn(2) & 0xFF00U, 1U << 8, "dynamic: S's 1201h");
+	t0 = bus.now;
+	/* Its boot-up starts the boot process (1F81h bit 2). */
+	node_reset(SLV);
+	co_bus_run_ms(1000);
+	zassert_equal(count(0x600U + ID_SLV, t0), 0, "the boot left 60Ah to the SRD");
+	zassert_false(seen_start(ID_SLV, t0), "boot not ended");
+	t0 = bus.now;
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, ID_SLV)), 0U);
+	co_bus_run_ms(500);
+	zassert_equal(conn(2), 0U, "released");
+	zassert_equal(conn(3), 0U, "released");
+	zassert_true(count_uploads(0x600U + ID_SLV, 0x1000, t0) > 0, "the boot goes on");
+	zassert_true(seen_start(ID_SLV, t0), "and ends: NMT start");
+}
+
+/*
+ * The SDO manager's own transfer to a slave (the 1000h check of a 1F00h) is not overlapped by
+ * the slave's boot: the boot's first upload goes out once the check ended.
+ */
+ZTEST(co_mgr_sdom, test_boot_waits_for_manager_transfer)
+{
+	uint64_t t0;
+
+	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
+	network(6);
+	srd_register(0x12800001U);
+	bus.port[SLV].alive = false;
+	t0 = bus.now;
+	zassert_equal(od_w(MGR, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV), CO_OD_WRITER_SDO), 0U);
+	co_bus_run_ms(10);
+	/* A boot-up of S while the manager's 1000h upload waits for its 100 ms timeout. */
+	inject(0x700U + ID_SLV, 1, 0, 0);
+	co_bus_run_ms(50);
+	zassert_equal(count(0x600U + ID_SLV, t0), 1, "only the SDO manager's request");
+	co_bus_run_ms(200);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000400U, "S did not answer: error 04h");
+	zassert_equal(count_uploads(0x600U + ID_SLV, 0x1000, t0), 2, "then the boot's upload");
+}
+
+/* An SRD with all default SDOs holds the slave's too: the boot waits until it gives them back. */
+ZTEST(co_mgr_sdom, test_boot_waits_for_all_default_sdos)
+{
+	uint64_t t0;
+
+	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
+	cfg(MGR, 0x1016, 1, HB(ID_SRD, 250U), 4);
+	cfg(SRD, 0x1017, 0, 100U, 2);
+	network(6);
+	srd_register(0x00000003U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000004U);
+	t0 = bus.now;
+	node_reset(SLV);
+	co_bus_run_ms(1000);
+	zassert_equal(count(0x600U + ID_SLV, t0), 0, "the boot left 60Ah to the SRD");
+	zassert_false(seen_start(ID_SLV, t0));
+	/* The SRD gives the default SDOs back by stopping its heartbeat. */
+	t0 = bus.now;
+	od_w16(SRD, 0x1017, 0, 0U);
+	co_bus_run_ms(1000);
+	zassert_true(seen(0x600U + ID_SLV, t0), "the boot goes on");
+	zassert_true(seen_start(ID_SLV, t0), "and ends: NMT start");
+}
+
+/* "All default SDOs" is granted once the running boot of a slave no longer uses its SDO. */
+ZTEST(co_mgr_sdom, test_all_default_sdos_wait_for_running_boot)
+{
+	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
+	/* The boot's "start error control" waits 500 ms for a heartbeat that never comes. */
+	cfg(MGR, 0x1016, 1, HB(ID_SLV, 500U), 4);
+	network(6);
+	node_reset(SLV);
+	co_bus_run_ms(50);
+	zassert_equal(od_w(SRD, 0x1F10, 0, 0x00000003U, CO_OD_WRITER_APP), 0U);
+	inject(0x6E0, 0, 0, 0);
+	co_bus_run_ms(200);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000003U, "not while the boot runs");
+	co_bus_run_ms(1000);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x00000004U, "granted after its end");
+}
+
+/*
+ * Req EC: the slave is guarded from its first connection (1F81h guard time, bit 0 clear: no
+ * NMT slave of ours) until its last one ends, by a release or by the de-registration.
+ */
+ZTEST(co_mgr_sdom, test_req_ec_supervision_ends_with_last_connection)
+{
+	uint64_t t0;
+
+	cfg(MGR, 0x1F81, ID_SLV, (100U << 16) | (3U << 8), 4);
+	network(6);
+	srd_register(0x12800009U);
+	zassert_equal(od_u(SRD, 0x1F10, 0), 0x1280000AU);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_equal(count_rtr(ID_SLV, t0), 0, "not supervised before a connection");
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_true(count_rtr(ID_SLV, t0) >= 4, "guarded (%d)", count_rtr(ID_SLV, t0));
+	/* One of two connections ends: still guarded. */
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_true(count_rtr(ID_SLV, t0) >= 4, "the other connection keeps it");
+	/* The last one: guarding stops. */
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0x1282, ID_SRD, ID_SLV)), 0U);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_equal(count_rtr(ID_SLV, t0), 0, "no connection left");
+	/* Again, ended by the de-registration (slave 0). */
+	zassert_equal(srd_download(0, 0x1F00, 0, REQ(0x1281, ID_SRD, ID_SLV)), 0U);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_true(count_rtr(ID_SLV, t0) >= 4, "guarded again");
+	zassert_equal(srd_download(0, 0x1F01, 0, REQ(0, ID_SRD, 0)), 0U);
+	co_bus_run_ms(100);
+	t0 = bus.now;
+	co_bus_run_ms(500);
+	zassert_equal(count_rtr(ID_SLV, t0), 0, "de-registered");
+}
+
 ZTEST_SUITE(co_mgr_sdom, NULL, NULL, before, after, NULL);
