@@ -533,8 +533,10 @@ int co_line_tx_purge(struct co_line *line, const struct k_mutex *origin,
  * @param line The line.
  * @param m The node's membership record; @p lock is the node's mutex.
  * @param lock The node's mutex.
+ * @retval 0 attached
+ * @retval -EBUSY another node is attached and CONFIG_CANOPEN_LINE_SHARED is off
  */
-void co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock);
+int co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock);
 
 /**
  * @brief Detach a node from the line, with every receiver and timer of its mutex.

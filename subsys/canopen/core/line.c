@@ -856,7 +856,7 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 		k_mutex_unlock(&line->lock);
 	}
 
-	if (line->dev == NULL) {
+	if (IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) && line->dev == NULL) {
 		co_line_local_drain(line);
 	}
 
@@ -1052,9 +1052,13 @@ int co_line_tx_space(struct co_line *line)
 	return space;
 }
 
-void co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock)
+int co_line_attach(struct co_line *line, struct co_line_member *m, const struct k_mutex *lock)
 {
 	k_mutex_lock(&line->lock, K_FOREVER);
+	if (!IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) && line->members != NULL) {
+		k_mutex_unlock(&line->lock);
+		return -EBUSY;
+	}
 	m->lock = lock;
 	m->next = line->members;
 	line->members = m;
@@ -1063,6 +1067,7 @@ void co_line_attach(struct co_line *line, struct co_line_member *m, const struct
 		__atomic_store_n(&line->n_nodes, (uint8_t)(line->n_nodes + 1U), __ATOMIC_RELAXED);
 	}
 	k_mutex_unlock(&line->lock);
+	return 0;
 }
 
 /* Drop every receiver and timer of one owner (a node leaving the line). */
@@ -1128,6 +1133,7 @@ bool co_line_owner_held(struct co_line *line)
 	return held;
 }
 
+#if defined(CONFIG_CANOPEN_LINE_SHARED)
 /* A frame a node sent, for the line's other nodes: through the RX queue to the line thread. */
 static __attribute__((noinline)) void
 local_deliver(struct co_line *line, const struct can_frame *frame, const struct k_mutex *origin)
@@ -1155,6 +1161,14 @@ int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 	}
 	return err;
 }
+#else
+/* One node per line: no other node to deliver to. */
+int co_line_send_from(struct co_line *line, const struct can_frame *frame,
+		      const struct k_mutex *origin)
+{
+	return line_send(line, frame, origin);
+}
+#endif /* CONFIG_CANOPEN_LINE_SHARED */
 
 void co_line_local_drain(struct co_line *line)
 {

@@ -187,7 +187,8 @@ static void line_drain(struct co_line *line, struct co_line_rx_msg *msg)
 	do {
 		if (msg->kind == CO_LINE_MSG_FRAME) {
 			co_line_rx(line, &msg->frame, msg->time_us);
-		} else if (msg->kind == CO_LINE_MSG_LOCAL) {
+		} else if (IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) &&
+			   msg->kind == CO_LINE_MSG_LOCAL) {
 			co_line_dispatch(line, &msg->frame, msg->time_us, msg->origin);
 		} else {
 			atomic_clear_bit(&line->flags, CO_LINE_F_WAKE_PENDING);

@@ -446,7 +446,11 @@ static int line_join(struct co_node *node, enum co_node_line_id idx, struct co_l
 	if (err != 0) {
 		return err;
 	}
-	co_line_attach(line, &nl->member, &node->lock);
+	err = co_line_attach(line, &nl->member, &node->lock);
+	if (err != 0) {
+		co_line_listener_remove(&nl->listener);
+		return err;
+	}
 	nl->line = line;
 	return 0;
 }

@@ -569,7 +569,9 @@ ZTEST(co_node_lock, test_dictionary_access_without_the_lock_stops_the_program)
 
 static void *node_setup(void)
 {
-	if (!full_hook_table(NULL) || !IS_ENABLED(CONFIG_CANOPEN_SYNC)) {
+	/* Its tests put several nodes on one line. */
+	if (!full_hook_table(NULL) || !IS_ENABLED(CONFIG_CANOPEN_SYNC) ||
+	    !IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED)) {
 		ztest_test_skip();
 	}
 	return NULL;
@@ -628,3 +630,43 @@ ZTEST(co_pdo_without_sync, test_synchronous_types_are_refused_06090030)
 }
 
 ZTEST_SUITE(co_pdo_without_sync, NULL, no_sync_setup, NULL, NULL, NULL);
+
+/* --- One node per line (scenario canopen.core.node.line_alone) ------------------------------ */
+
+ZTEST(co_node_line_nodes, test_second_node_on_a_line_refused_only_when_not_shared)
+{
+	static struct co_node a;
+	static struct co_node b;
+	static struct node_test_od_ram ram_a;
+	static struct node_test_od_ram ram_b;
+	const bool shared = IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED);
+
+	co_sim_init();
+	zassert_ok(co_node_init(&a, "a", &sim.line, &node_test_od_def, &ram_a, NODE_ID));
+	zassert_equal(co_node_init(&b, "b", &sim.line, &node_test_od_def, &ram_b, NODE_ID + 1),
+		      shared ? 0 : -EBUSY);
+	zassert_ok(co_node_start(&a));
+	if (shared) {
+		zassert_ok(co_node_start(&b));
+	}
+	/* The refused node left nothing on the line: the first one still gets its commands. */
+	co_sim_nmt(CO_NMT_CS_START, NODE_ID);
+	zassert_equal(co_nmt_get_state(&a), CO_NMT_OPERATIONAL);
+	co_sim_nmt(CO_NMT_CS_START, 0);
+	zassert_equal(co_nmt_get_state(&a), CO_NMT_OPERATIONAL);
+	if (shared) {
+		zassert_equal(co_nmt_get_state(&b), CO_NMT_OPERATIONAL);
+		co_line_detach(&sim.line, &b.lines[CO_LINE_DEFAULT].member);
+	}
+	co_line_detach(&sim.line, &a.lines[CO_LINE_DEFAULT].member);
+}
+
+static void *line_nodes_setup(void)
+{
+	if (!full_hook_table(NULL)) {
+		ztest_test_skip();
+	}
+	return NULL;
+}
+
+ZTEST_SUITE(co_node_line_nodes, NULL, line_nodes_setup, NULL, NULL, NULL);
