@@ -18,7 +18,7 @@
 
 #include <canopen/pgm.h>
 
-#include "pgm_flash_file_host.h"
+#include "host_file.h"
 
 #define CHUNK 256U
 
@@ -51,8 +51,8 @@ static int file_erase(struct co_pgm_flash *f, uint8_t slot)
 	}
 	memset(ones, 0xff, sizeof(ones));
 	for (uint32_t off = 0; off < end && err == 0; off += CHUNK) {
-		err = co_pgm_host_pwrite(ff->fd, slot_base(f, slot) + off, ones,
-					 MIN(CHUNK, end - off));
+		err = co_host_file_pwrite(ff->fd, slot_base(f, slot) + off, ones,
+					  MIN(CHUNK, end - off));
 	}
 	if (err != 0) {
 		return err;
@@ -72,7 +72,7 @@ static int check_erased(struct co_pgm_flash_file *ff, uint32_t pos, const uint8_
 
 	for (size_t done = 0; done < len; done += CHUNK) {
 		size_t n = MIN(CHUNK, len - done);
-		int err = co_pgm_host_pread(ff->fd, pos + (uint32_t)done, cur, n);
+		int err = co_host_file_pread(ff->fd, pos + (uint32_t)done, cur, n);
 
 		if (err != 0) {
 			return err;
@@ -108,7 +108,7 @@ static int file_write(struct co_pgm_flash *f, uint8_t slot, uint32_t off, const 
 		n = (size_t)ff->budget;
 	}
 	/* Every bit of the data is set in the erased bytes: writing it clears only bits. */
-	err = n > 0U ? co_pgm_host_pwrite(ff->fd, pos, data, n) : 0;
+	err = n > 0U ? co_host_file_pwrite(ff->fd, pos, data, n) : 0;
 	if (err != 0) {
 		return err;
 	}
@@ -133,7 +133,7 @@ static int file_read(struct co_pgm_flash *f, uint8_t slot, uint32_t off, void *b
 	if (slot > 1U || (uint64_t)off + len > f->slot_size) {
 		return -EINVAL;
 	}
-	return co_pgm_host_pread(ff->fd, slot_base(f, slot) + off, buf, len);
+	return co_host_file_pread(ff->fd, slot_base(f, slot) + off, buf, len);
 }
 
 static const struct co_pgm_flash_api file_api = {
@@ -151,14 +151,14 @@ int co_pgm_flash_file_open(struct co_pgm_flash_file *ff, const char *path, uint3
 	    slot_size > UINT32_MAX / 2U) {
 		return -EINVAL;
 	}
-	fd = co_pgm_host_open(path);
+	fd = co_host_file_open(path);
 	if (fd < 0) {
 		return fd;
 	}
-	size = co_pgm_host_size(fd);
+	size = co_host_file_size(fd);
 	if (size < 0 || size > 2 * (int64_t)slot_size) {
 		/* Not a flash of this geometry: refuse rather than misread its slots. */
-		co_pgm_host_close(fd);
+		co_host_file_close(fd);
 		return size < 0 ? (int)size : -EFBIG;
 	}
 	memset(ff, 0, sizeof(*ff));
@@ -172,7 +172,7 @@ int co_pgm_flash_file_open(struct co_pgm_flash_file *ff, const char *path, uint3
 void co_pgm_flash_file_close(struct co_pgm_flash_file *ff)
 {
 	if (ff->fd >= 0) {
-		co_pgm_host_close(ff->fd);
+		co_host_file_close(ff->fd);
 		ff->fd = -1;
 	}
 }

@@ -3,13 +3,13 @@
  * SPDX-License-Identifier: Apache-2.0
  */
 
-/* File storage backend for native_posix; the host calls live in storage_file_host.c. */
+/* File storage backend for native_posix; the host calls live in core/host_file.c. */
 
 #include <errno.h>
 
 #include <canopen/storage.h>
 
-#include "storage_file_host.h"
+#include "host_file.h"
 
 static const struct co_storage_file *file_of(const struct co_storage_backend *be)
 {
@@ -23,7 +23,7 @@ static int file_read(const struct co_storage_backend *be, uint32_t offset, void 
 	if (offset > f->size || len > f->size - offset) {
 		return -EINVAL;
 	}
-	return co_storage_host_pread(f->fd, offset, buf, len);
+	return co_host_file_pread(f->fd, offset, buf, len);
 }
 
 static int file_write(const struct co_storage_backend *be, uint32_t offset, const void *buf,
@@ -34,12 +34,12 @@ static int file_write(const struct co_storage_backend *be, uint32_t offset, cons
 	if (offset > f->size || len > f->size - offset) {
 		return -ENOSPC;
 	}
-	return co_storage_host_pwrite(f->fd, offset, buf, len);
+	return co_host_file_pwrite(f->fd, offset, buf, len);
 }
 
 static int file_sync(const struct co_storage_backend *be)
 {
-	return co_storage_host_fsync(file_of(be)->fd);
+	return co_host_file_sync(file_of(be)->fd);
 }
 
 static uint32_t file_size(const struct co_storage_backend *be)
@@ -59,7 +59,7 @@ int co_storage_file_open(struct co_storage_file *f, const char *path, uint32_t s
 	if (f == NULL || path == NULL || size < 64U) {
 		return -EINVAL;
 	}
-	int fd = co_storage_host_open(path);
+	int fd = co_host_file_open(path);
 
 	if (fd < 0) {
 		return fd;
@@ -73,7 +73,7 @@ int co_storage_file_open(struct co_storage_file *f, const char *path, uint32_t s
 void co_storage_file_close(struct co_storage_file *f)
 {
 	if (f != NULL && f->fd >= 0) {
-		co_storage_host_close(f->fd);
+		co_host_file_close(f->fd);
 		f->fd = -1;
 	}
 }

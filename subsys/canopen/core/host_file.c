@@ -3,7 +3,7 @@
  * SPDX-License-Identifier: Apache-2.0
  */
 
-/* Host side of the file flash (native board only): POSIX file calls. */
+/* Host files of the native board's file-backed media: POSIX file calls (host_file.h). */
 
 #include <errno.h>
 #include <fcntl.h>
@@ -11,23 +11,23 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "pgm_flash_file_host.h"
+#include "host_file.h"
 
-int co_pgm_host_open(const char *path)
+int co_host_file_open(const char *path)
 {
 	int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, S_IRUSR | S_IWUSR);
 
 	return fd >= 0 ? fd : -errno;
 }
 
-int64_t co_pgm_host_size(int fd)
+int64_t co_host_file_size(int fd)
 {
 	struct stat st;
 
 	return fstat(fd, &st) == 0 ? (int64_t)st.st_size : -errno;
 }
 
-int co_pgm_host_pread(int fd, uint32_t offset, void *buf, size_t len)
+int co_host_file_pread(int fd, uint32_t offset, void *buf, size_t len)
 {
 	size_t done = 0;
 
@@ -42,7 +42,7 @@ int co_pgm_host_pread(int fd, uint32_t offset, void *buf, size_t len)
 		}
 		if (n == 0) {
 			/* Never written: erased. */
-			memset((char *)buf + done, 0xFF, len - done);
+			(void)memset((char *)buf + done, 0xFF, len - done);
 			break;
 		}
 		done += (size_t)n;
@@ -50,7 +50,7 @@ int co_pgm_host_pread(int fd, uint32_t offset, void *buf, size_t len)
 	return 0;
 }
 
-int co_pgm_host_pwrite(int fd, uint32_t offset, const void *buf, size_t len)
+int co_host_file_pwrite(int fd, uint32_t offset, const void *buf, size_t len)
 {
 	size_t done = 0;
 
@@ -64,12 +64,21 @@ int co_pgm_host_pwrite(int fd, uint32_t offset, const void *buf, size_t len)
 			}
 			return -errno;
 		}
+		if (n == 0) {
+			/* Nothing written and no error: it would only loop. */
+			return -ENOSPC;
+		}
 		done += (size_t)n;
 	}
 	return 0;
 }
 
-void co_pgm_host_close(int fd)
+int co_host_file_sync(int fd)
+{
+	return fsync(fd) == 0 ? 0 : -errno;
+}
+
+void co_host_file_close(int fd)
 {
 	(void)close(fd);
 }
