@@ -87,7 +87,7 @@ void co_mgr_hb_start(struct co_mgr_slave *s, uint64_t now)
 }
 
 /* CiA 302-2 §4.2 error handler. */
-static void error_handler(struct co_mgr_slave *s)
+static void error_handler(struct co_mgr_slave *s, enum co_mgr_ec_event ev)
 {
 	struct co_mgr *m = s->mgr;
 	uint32_t as = co_mgr_assign(m, s->id);
@@ -98,6 +98,11 @@ static void error_handler(struct co_mgr_slave *s)
 	}
 	if ((as & AS_MANDATORY) != 0U) {
 		if ((su & SU_STOP_ALL) != 0U) {
+			/*
+			 * Without this a startup waiting for another mandatory slave (no 1F89h)
+			 * would wait forever for a boot the Stopped master cannot run (fuzzing).
+			 */
+			co_mgr_startup_halt_ec(s, ev == CO_MGR_EC_GUARD_LOST);
 			(void)co_mgr_nmt_queue(m, CO_NMT_CS_STOP, 0U, true);
 			return;
 		}
@@ -137,7 +142,7 @@ static void ec_event(struct co_mgr_slave *s, enum co_mgr_ec_event ev)
 #if defined(CONFIG_CANOPEN_MGR_SDOM)
 	co_mgr_sdom_lost(m, s->id);
 #endif
-	error_handler(s);
+	error_handler(s, ev);
 }
 
 void co_mgr_ec_timer_handler(struct co_timer *timer, uint64_t now_us)

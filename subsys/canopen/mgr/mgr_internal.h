@@ -189,6 +189,13 @@ void co_mgr_startup_resets_sent(struct co_mgr *m);
  * indication, which may change 1F81h.
  */
 void co_mgr_startup_boot_ended(struct co_mgr_slave *s, bool mandatory, uint64_t now);
+/*
+ * The error handler stops the network ("stop all", 1F80h bit 6) for a mandatory slave whose
+ * error control failed (@p guarding: node guarding, else heartbeat): a running startup that
+ * still waits for a mandatory slave halts with that slave's error (F or K), since the Stopped
+ * master cannot boot it.
+ */
+void co_mgr_startup_halt_ec(struct co_mgr_slave *s, bool guarding);
 /* Whether a mandatory slave has not booted yet (the initial startup may still halt). */
 bool co_mgr_mandatory_pending(struct co_mgr *m);
 void co_mgr_start_timer_handler(struct co_timer *timer, uint64_t now_us);

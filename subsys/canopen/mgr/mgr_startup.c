@@ -33,6 +33,20 @@ static void halt(struct co_mgr *m, const struct co_mgr_boot_error *err)
 	}
 }
 
+void co_mgr_startup_halt_ec(struct co_mgr_slave *s, bool guarding)
+{
+	struct co_mgr_boot_error e = {
+		.node_id = s->id,
+		.status = guarding ? CO_MGR_ST_F : CO_MGR_ST_K,
+		.step = CO_MGR_STEP_IDLE,
+	};
+
+	/* Boots that all ended go on to DONE (skipping S5/S6): nothing waits for the master. */
+	if (co_mgr_mandatory_pending(s->mgr)) {
+		halt(s->mgr, &e);
+	}
+}
+
 bool co_mgr_mandatory_pending(struct co_mgr *m)
 {
 	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {

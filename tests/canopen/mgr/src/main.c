@@ -2429,6 +2429,63 @@ ZTEST(co_mgr, test_stop_all_on_mandatory_guarding_loss_aborts_boot_sdo_and_ends_
 	zassert_equal(info.attempts, 2);
 }
 
+/*
+ * Found by fuzzing: the same stop while a second mandatory slave has not booted and 1F89h is
+ * 0 (wait for ever). The Stopped master cannot boot it, so the startup would run for ever; it
+ * halts with the lost slave's error instead: F for guarding, K for heartbeat.
+ */
+static void stop_all_with_a_mandatory_slave_pending(bool guarding)
+{
+	struct fake *f;
+
+	cfg(0x1F80, 0, 0x41, 4);
+	cfg(0x1F81, 2, guarding ? 0x0032010DU : 0x0DU, 4);
+	cfg(0x1F81, 3, 0x0D, 4); /* mandatory, never answers */
+	if (!guarding) {
+		cfg(0x1016, 1, (2U << 16) | 100U, 4);
+	}
+	f = fake_std(2);
+	if (guarding) {
+		f->rtr_skip = 1;
+	} else {
+		f->hb_ms = 50;
+		f->next_hb = 10 * MS;
+	}
+	start_master();
+	run_for(guarding ? 90 * MS : 300 * MS);
+	if (!guarding) {
+		zassert_equal(last_boot_status(2), CO_MGR_ST_OK);
+		zassert_equal(master_state(), CO_NMT_PRE_OPERATIONAL);
+		zassert_equal(t.n_startup_ind, 0, "waits for node 3");
+		f->present = false;
+		run_for(300 * MS);
+	}
+	zassert_equal(master_state(), CO_NMT_STOPPED);
+	zassert_equal(count_nmt(0x02, 0), 1);
+	zassert_equal(t.n_startup_ind, 1, "the startup ends");
+	zassert_equal(co_mgr_get_startup(&t.master), CO_MGR_STARTUP_HALTED);
+	zassert_equal(t.startup_result, CO_MGR_STARTUP_HALTED);
+	zassert_equal(t.startup_err.node_id, 2);
+	zassert_equal(t.startup_err.status, guarding ? CO_MGR_ST_F : CO_MGR_ST_K);
+	run_for(3000 * MS);
+	zassert_equal(t.n_startup_ind, 1);
+	zassert_equal(master_state(), CO_NMT_STOPPED);
+	for (int i = 0; i < t.n_log; i++) {
+		zassert_false(t.log[i].f.id == 0x000 && t.log[i].f.data[0] == 0x01,
+			      "nothing started");
+	}
+}
+
+ZTEST(co_mgr, test_stop_all_on_guarding_loss_halts_a_startup_waiting_for_a_mandatory_slave)
+{
+	stop_all_with_a_mandatory_slave_pending(true);
+}
+
+ZTEST(co_mgr, test_stop_all_on_heartbeat_loss_halts_a_startup_waiting_for_a_mandatory_slave)
+{
+	stop_all_with_a_mandatory_slave_pending(false);
+}
+
 /* --- The boot waits for the slave's boot-up after the startup's reset (302-2 §3.1) ------------ */
 
 /*
