@@ -119,6 +119,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--time", type=float, default=10, help="seconds of mutation")
     ap.add_argument("--seed", type=int, default=20, help="random seed (default 20)")
+    ap.add_argument("--runs", type=int, default=0,
+                    help="stop after this many mutated inputs (0: only --time bounds the loop)")
     ap.add_argument("--work", default=None, help="where a failing input is written")
     ap.add_argument("--replay-only", action="store_true")
     ap.add_argument("files", nargs="*", help="inputs to check once (instead of fuzzing)")
@@ -154,7 +156,9 @@ def main():
     seeds = [(open(p, encoding="utf-8").read(), os.path.splitext(p)[1])
              for p in sorted(glob.glob(os.path.join(HERE, "corpus", "*")))]
     end = time.monotonic() + args.time
-    while time.monotonic() < end:
+    runs = 0
+    while time.monotonic() < end and (args.runs == 0 or runs < args.runs):
+        runs += 1
         text, ext = rng.choice(seeds)
         text = mutate(rng, text)
         path = os.path.join(tmp, "input" + ext)

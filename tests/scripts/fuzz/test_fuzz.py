@@ -4,7 +4,9 @@
 (SAFELINE_FUZZ_BREAK=1 makes Operational an invalid NMT state), bad arguments, and the
 eds2od harness's verdicts."""
 
+import glob
 import os
+import re
 import subprocess
 import sys
 
@@ -59,6 +61,14 @@ def test_a_broken_invariant_fails_the_run_and_names_it():
 
 
 @needs_clang
+def test_a_counted_run_fuzzes_that_many_inputs_with_the_seed():
+    r = fuzz("nmt", "--runs", "300", "--seed", "1", "--no-save")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "300 inputs each, seed 1" in r.stdout.splitlines()[0]
+    assert re.search(r"^nmt +ok +300 executions$", r.stdout, re.M), r.stdout
+
+
+@needs_clang
 def test_unknown_harness_is_refused():
     r = fuzz("nosuch", "--time", "1")
     assert r.returncode == 2
@@ -74,6 +84,14 @@ def test_time_below_one_is_refused():
 def eds_harness(*args):
     return subprocess.run([sys.executable, os.path.join(EDS_HARNESS_DIR, "fuzz_eds2od.py"),
                            *args], capture_output=True, text=True, cwd=BASE, timeout=300)
+
+
+def test_eds2od_harness_stops_after_its_count_of_mutations():
+    replays = len(glob.glob(os.path.join(EDS_HARNESS_DIR, "regressions", "*"))) + \
+        len(glob.glob(os.path.join(EDS_HARNESS_DIR, "corpus", "*")))
+    r = eds_harness("--runs", "40", "--time", "600")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.stdout.splitlines()[-1] == f"executions: {replays + 40}"
 
 
 def test_eds2od_harness_accepts_its_corpus_and_regressions():
