@@ -535,6 +535,23 @@ int co_od_provider_register(struct co_od *od, const struct co_od_provider *p);
  */
 uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct co_od_info *info);
 
+/**
+ * @brief Fill @p info for a dictionary object from its descriptor, as co_od_find() does.
+ *
+ * For a caller that keeps the descriptor of an object found once (with the object's index,
+ * object code and group) and rebuilds its info when it accesses it, instead of keeping the
+ * whole info (the PDO mapping of a small build).
+ *
+ * @param od      dictionary of @p desc
+ * @param desc    sub-index descriptor of a dictionary object (not a provider's)
+ * @param index   its index
+ * @param objcode its object code (enum co_od_objcode)
+ * @param group   its group (enum co_od_group)
+ * @param info    filled
+ */
+void co_od_info_fill(const struct co_od *od, const struct co_od_sub *desc, uint16_t index,
+		     uint8_t objcode, uint8_t group, struct co_od_info *info);
+
 /** @brief Current length in bytes of the value (strings up to the NUL, domains). */
 uint32_t co_od_length(const struct co_od *od, const struct co_od_info *info);
 

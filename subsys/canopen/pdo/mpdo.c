@@ -106,16 +106,19 @@ static enum co_mpdo_rx_result write_object(struct co_node *node, uint16_t index,
 					   const uint8_t data[4], bool dam)
 {
 	struct co_pdo_map_ent ent = {0};
+	struct co_od_info tmp;
+	struct co_od_info *info = co_pdo_ent_find_buf(&ent, &tmp);
 	uint8_t val[8] = {0};
 
-	if (co_od_find(&node->od, index, sub, &ent.info) != 0U) {
+	if (co_od_find(&node->od, index, sub, info) != 0U) {
 		return dam ? CO_MPDO_RX_MISSING : CO_MPDO_RX_REFUSED;
 	}
-	if (!mpdo_sized(&ent.info)) {
+	if (!mpdo_sized(info)) {
 		return CO_MPDO_RX_REFUSED;
 	}
+	co_pdo_ent_set(&ent, info);
 #if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	ent.bits = (uint8_t)(ent.info.size * 8U);
+	ent.bits = (uint8_t)(info->size * 8U);
 #endif
 	memcpy(val, data, MPDO_MAX_BYTES);
 	return co_pdo_ent_write(&node->od, &ent, val, CO_OD_WRITER_MPDO) == 0U ? CO_MPDO_RX_WRITTEN

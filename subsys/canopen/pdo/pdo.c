@@ -199,8 +199,8 @@ static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n
 			bytewise = false;
 		}
 		/* Consecutive sub-indexes of one object share a change-of-state hook. */
-		if (i == 1U || prev.info.index != ent.info.index ||
-		    prev.info.sub + 1U != ent.info.sub) {
+		if (i == 1U || co_pdo_ent_index(&prev) != co_pdo_ent_index(&ent) ||
+		    co_pdo_ent_sub(&prev) + 1U != co_pdo_ent_sub(&ent)) {
 			(*runs)++;
 		}
 		prev = ent;
@@ -665,10 +665,11 @@ static uint8_t cos_hooks_needed(const struct co_pdo_map *map, uint8_t type)
 		return 0U;
 	}
 	for (uint8_t i = 0; i < map->n; i++) {
-		const struct co_od_info *a = &map->ent[i].info;
-		const struct co_od_info *p = i > 0U ? &map->ent[i - 1U].info : NULL;
+		const struct co_pdo_map_ent *a = &map->ent[i];
+		const struct co_pdo_map_ent *p = i > 0U ? &map->ent[i - 1U] : NULL;
 
-		if (p == NULL || p->index != a->index || p->sub + 1U != a->sub) {
+		if (p == NULL || co_pdo_ent_index(p) != co_pdo_ent_index(a) ||
+		    co_pdo_ent_sub(p) + 1U != co_pdo_ent_sub(a)) {
 			n++;
 		}
 	}
@@ -693,17 +694,18 @@ static void cos_hooks_update(struct co_tpdo *t)
 		return;
 	}
 	for (uint8_t i = 0; i < t->map.n; i++) {
-		const struct co_od_info *a = &t->map.ent[i].info;
-		struct co_od_hook h = {a->index, a->index, a->sub, a->sub, NULL, cos_notify, t};
+		uint16_t index = co_pdo_ent_index(&t->map.ent[i]);
+		uint8_t sub = co_pdo_ent_sub(&t->map.ent[i]);
+		struct co_od_hook h = {index, index, sub, sub, NULL, cos_notify, t};
 
-		while (i + 1U < t->map.n && t->map.ent[i + 1U].info.index == a->index &&
-		       t->map.ent[i + 1U].info.sub == h.sub_last + 1U) {
+		while (i + 1U < t->map.n && co_pdo_ent_index(&t->map.ent[i + 1U]) == index &&
+		       co_pdo_ent_sub(&t->map.ent[i + 1U]) == h.sub_last + 1U) {
 			h.sub_last++;
 			i++;
 		}
 		if (co_od_hook_register(od, &h) != 0) {
 			LOG_ERR("%s: no OD hook for change of state of %04Xh", t->node->name,
-				a->index);
+				index);
 			continue;
 		}
 		t->n_hooks++;

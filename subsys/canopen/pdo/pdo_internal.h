@@ -66,7 +66,90 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 /* Whether an entry is a dummy (skips bits of an RPDO). */
 static inline bool co_pdo_ent_is_dummy(const struct co_pdo_map_ent *ent)
 {
+#if CO_PDO_ENT_COMPACT
+	return ent->desc == NULL;
+#else
 	return ent->info.desc == NULL && ent->info.prov == NULL;
+#endif
+}
+
+/* An entry's object index (a dummy's: its type 0001h-0007h). */
+static inline uint16_t co_pdo_ent_index(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_COMPACT
+	return ent->index;
+#else
+	return ent->info.index;
+#endif
+}
+
+/* An entry's sub-index (0 for a dummy). */
+static inline uint8_t co_pdo_ent_sub(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_COMPACT
+	return ent->desc != NULL ? ent->desc->sub : 0U;
+#else
+	return ent->info.sub;
+#endif
+}
+
+/* An entry's object size on the wire in bytes (a dummy's: its type's whole bytes). */
+static inline uint32_t co_pdo_ent_size(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_COMPACT
+	return ent->desc != NULL ? ent->desc->size : co_dtype_size(ent->index);
+#else
+	return ent->info.size;
+#endif
+}
+
+/*
+ * The co_od_info of an entry that is not a dummy, for the accessors: its own, or rebuilt in
+ * @p tmp from what a compact entry keeps.
+ */
+static inline const struct co_od_info *
+co_pdo_ent_info(const struct co_od *od, const struct co_pdo_map_ent *ent, struct co_od_info *tmp)
+{
+#if CO_PDO_ENT_COMPACT
+	co_od_info_fill(od, ent->desc, ent->index, ent->objcode, ent->group, tmp);
+	return tmp;
+#else
+	(void)od;
+	(void)tmp;
+	return &ent->info;
+#endif
+}
+
+/*
+ * Where co_od_find() describes an entry's object: the entry's own info, or @p tmp for a
+ * compact entry; co_pdo_ent_set() then makes it the entry's object.
+ */
+static inline struct co_od_info *co_pdo_ent_find_buf(struct co_pdo_map_ent *ent,
+						     struct co_od_info *tmp)
+{
+#if CO_PDO_ENT_COMPACT
+	(void)ent;
+	return tmp;
+#else
+	(void)tmp;
+	return &ent->info;
+#endif
+}
+
+/* Make @p ent the entry of the dictionary object @p info (from co_od_find()). */
+static inline void co_pdo_ent_set(struct co_pdo_map_ent *ent, const struct co_od_info *info)
+{
+#if CO_PDO_ENT_COMPACT
+	/* Without providers every object found has a descriptor. */
+	ent->desc = info->desc;
+	ent->index = info->index;
+	ent->objcode = info->objcode;
+	ent->group = info->group;
+#else
+	if (info != &ent->info) {
+		ent->info = *info;
+	}
+#endif
 }
 
 /*
@@ -79,7 +162,7 @@ static inline unsigned int co_pdo_ent_bits(const struct co_pdo_map_ent *ent)
 #if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	return ent->bits;
 #else
-	return ent->info.size * 8U;
+	return co_pdo_ent_size(ent) * 8U;
 #endif
 }
 
@@ -133,6 +216,7 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
 					     uint8_t data[8])
 {
+#if CO_OD_COVER
 	if (likely(CO_PDO_MAP_FAST(map, od->hook_gen))) {
 		uint8_t frame[8] = {0};
 		unsigned int off = 0;
@@ -146,6 +230,7 @@ static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_p
 		memcpy(data, frame, sizeof(frame));
 		return (uint8_t)(off);
 	}
+#endif
 	return co_pdo_map_pack_gen(od, map, data);
 }
 
@@ -156,6 +241,7 @@ static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_p
 static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map,
 					   const uint8_t *data)
 {
+#if CO_OD_COVER
 	uint32_t gen = od->hook_gen;
 
 	if (likely(CO_PDO_MAP_FAST(map, gen))) {
@@ -176,6 +262,7 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 		}
 		return 0;
 	}
+#endif
 	return co_pdo_map_unpack_gen(od, map, data, 0U, 0U);
 }
 

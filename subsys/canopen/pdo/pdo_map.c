@@ -59,30 +59,38 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 		    (!bitwise && bits % 8U != 0U)) {
 			return CO_SDO_AB_NO_MAP;
 		}
+#if CO_PDO_ENT_COMPACT
+		/* Its whole bytes are its type's size (co_pdo_ent_size()). */
+		ent->index = index;
+#else
 		ent->info.index = index;
 		ent->info.dtype = (uint8_t)index;
 		/* Its whole bytes: the length co_pdo_ent_bits() gives without bit-wise mapping. */
 		ent->info.size = (uint32_t)bits / 8U;
+#endif
 		return 0U;
 	}
-	uint32_t ab = co_od_find(od, index, sub, &ent->info);
+	struct co_od_info tmp;
+	struct co_od_info *info = co_pdo_ent_find_buf(ent, &tmp);
+	uint32_t ab = co_od_find(od, index, sub, info);
 
 	if (ab != 0U) {
 		return ab;
 	}
-	if (!mappable(&ent->info, rx) || bits == 0U) {
+	co_pdo_ent_set(ent, info);
+	if (!mappable(info, rx) || bits == 0U) {
 		return CO_SDO_AB_NO_MAP;
 	}
 	if (bits > CO_PDO_MAX_BITS) {
 		return CO_SDO_AB_MAP_LEN;
 	}
-	uint32_t size_bits = ent->info.size * 8U;
+	uint32_t size_bits = info->size * 8U;
 
 	if (bits > size_bits || (!bitwise && bits % 8U != 0U)) {
 		return CO_SDO_AB_NO_MAP;
 	}
 	/* Part of an object: only the low-order bits of a fixed-size number (bit-wise mode). */
-	if (bits < size_bits && (!bitwise || co_dtype_size(ent->info.dtype) == 0U)) {
+	if (bits < size_bits && (!bitwise || co_dtype_size(info->dtype) == 0U)) {
 		return CO_SDO_AB_NO_MAP;
 	}
 #if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
@@ -123,12 +131,14 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 			 enum co_od_writer reader)
 {
 	size_t len = 0;
-	size_t cap = ent->info.size < 8U ? ent->info.size : 8U;
+	struct co_od_info tmp;
+	const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
+	size_t cap = info->size < 8U ? info->size : 8U;
 	unsigned int whole = co_pdo_ent_bits(ent) / 8U;
 	uint32_t ab;
 
 	memset(out, 0, 8);
-	ab = co_od_read_cached(od, &ent->info, CO_PDO_ENT_COVER(ent), out, cap, &len, reader);
+	ab = co_od_read_cached(od, info, CO_PDO_ENT_COVER(ent), out, cap, &len, reader);
 	if (ab != 0U) {
 		memset(out, 0, 8);
 		return ab;
@@ -148,18 +158,19 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 			  enum co_od_writer writer)
 {
 	uint8_t buf[8];
-	uint32_t size = ent->info.size;
+	struct co_od_info tmp;
+	const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
+	uint32_t size = info->size;
 
 	memcpy(buf, val, sizeof(buf));
 	/* A signed number mapped in part keeps its sign. */
-	if (co_pdo_ent_bits(ent) < size * 8U &&
-	    co_dtype_class(ent->info.dtype) == CO_DTYPE_CLASS_INT &&
+	if (co_pdo_ent_bits(ent) < size * 8U && co_dtype_class(info->dtype) == CO_DTYPE_CLASS_INT &&
 	    ((buf[(co_pdo_ent_bits(ent) - 1U) / 8U] >> ((co_pdo_ent_bits(ent) - 1U) % 8U)) & 1U)) {
 		for (unsigned int b = co_pdo_ent_bits(ent); b < size * 8U; b++) {
 			buf[b / 8U] |= (uint8_t)(1U << (b % 8U));
 		}
 	}
-	return co_od_write_cached(od, &ent->info, CO_PDO_ENT_COVER(ent), buf, size, writer);
+	return co_od_write_cached(od, info, CO_PDO_ENT_COVER(ent), buf, size, writer);
 }
 
 #if CO_OD_COVER
@@ -214,11 +225,13 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 	for (uint8_t i = 0; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
 		size_t len;
+		struct co_od_info tmp;
 
 		if (!BITWISE || (map->bytewise && co_pdo_ent_whole(ent))) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
-			if (co_od_read_cached(od, &ent->info, CO_PDO_ENT_COVER(ent),
-					      &data[off / 8U], co_pdo_ent_bits(ent) / 8U, &len,
+			if (co_od_read_cached(od, co_pdo_ent_info(od, ent, &tmp),
+					      CO_PDO_ENT_COVER(ent), &data[off / 8U],
+					      co_pdo_ent_bits(ent) / 8U, &len,
 					      CO_OD_WRITER_PDO) != 0U) {
 				memset(&data[off / 8U], 0, co_pdo_ent_bits(ent) / 8U);
 			}
@@ -245,11 +258,13 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 	/* Byte-wise mappings count bytes, bit-wise ones bits. */
 	for (uint8_t i = from; i < map->n; i++) {
 		struct co_pdo_map_ent *ent = &map->ent[i];
+		struct co_od_info tmp;
 
 		if (BITWISE ? map->bytewise && co_pdo_ent_whole(ent) : !co_pdo_ent_is_dummy(ent)) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
-			refused += co_od_write_cached(od, &ent->info, CO_PDO_ENT_COVER(ent),
-						      &data[off], co_pdo_ent_bits(ent) / 8U,
+			refused += co_od_write_cached(od, co_pdo_ent_info(od, ent, &tmp),
+						      CO_PDO_ENT_COVER(ent), &data[off],
+						      co_pdo_ent_bits(ent) / 8U,
 						      CO_OD_WRITER_PDO) != 0U;
 		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));

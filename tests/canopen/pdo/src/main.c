@@ -460,6 +460,84 @@ ZTEST(co_pdo, test_rpdo_hook_that_changes_the_hook_table_mid_frame)
 	co_node_unlock(&t.node);
 }
 
+/*
+ * The hooks of a mapped object see it as co_od_find() describes it, whatever the mapping
+ * entry keeps (a compact entry rebuilds the description at each frame).
+ */
+static struct co_od_info seen_info[2];
+static int n_seen;
+
+static uint32_t record_info(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	if (n_seen < 2) {
+		seen_info[n_seen] = *req->info;
+	}
+	n_seen++;
+	zassert_equal(req->writer, CO_OD_WRITER_PDO);
+	return 0U;
+}
+
+static void assert_info_is_found(const struct co_od_info *seen, uint16_t index, uint8_t sub)
+{
+	struct co_od_info found;
+
+	zassert_equal(co_od_find(co_node_od(&t.node), index, sub, &found), 0U);
+	zassert_equal_ptr(seen->desc, found.desc, "%04Xh:%u", index, sub);
+	zassert_equal_ptr(seen->prov, found.prov);
+	zassert_equal_ptr(seen->limit, found.limit);
+	zassert_equal(seen->size, found.size);
+	zassert_equal(seen->index, index);
+	zassert_equal(seen->sub, sub);
+	zassert_equal(seen->dtype, found.dtype);
+	zassert_equal(seen->access, found.access);
+	zassert_equal(seen->flags, found.flags);
+	zassert_equal(seen->objcode, found.objcode, "%04Xh:%u", index, sub);
+	zassert_equal(seen->group, found.group);
+}
+
+ZTEST(co_pdo, test_rpdo_hooks_see_the_mapped_objects_as_found)
+{
+	const struct co_od_hook rec[2] = {
+		{0x2000, 0x2000, 1, 1, record_info, NULL, &n_seen},
+		{0x2001, 0x2001, 0, 0, record_info, NULL, &n_seen},
+	};
+
+	n_seen = 0;
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &rec[0]));
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &rec[1]));
+	co_node_unlock(&t.node);
+	go_operational();
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x41, 0x42, 0x43});
+	zassert_equal(n_seen, 2, "one validate call per mapped object");
+	assert_info_is_found(&seen_info[0], 0x2000, 1);
+	assert_info_is_found(&seen_info[1], 0x2001, 0);
+	zassert_equal(get_u8(0x2000, 1), 0x41);
+	zassert_equal(get_u16(0x2001, 0), 0x4342);
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &n_seen), 2);
+	co_node_unlock(&t.node);
+}
+
+/* Without the cache and providers a mapping entry keeps a descriptor and three small fields
+ * (CO_PDO_ENT_COMPACT); with either it keeps the whole co_od_info.
+ */
+ZTEST(co_pdo, test_map_entry_compact)
+{
+	bool compact =
+		!IS_ENABLED(CONFIG_CANOPEN_OD_COVER) && !IS_ENABLED(CONFIG_CANOPEN_OD_PROVIDERS);
+
+	zassert_equal(CO_PDO_ENT_COMPACT, compact);
+	if (!compact) {
+		zassert_true(sizeof(struct co_pdo_map_ent) >= sizeof(struct co_od_info));
+		return;
+	}
+	zassert_true(sizeof(struct co_pdo_map_ent) < sizeof(struct co_od_info));
+	if (!IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)) {
+		zassert_equal(sizeof(struct co_pdo_map_ent), 2U * sizeof(void *));
+	}
+}
+
 /* A read check registered on a mapped object after the TPDO went out is heard: zeros. */
 static uint32_t no_read_2002(const struct co_od *od, const struct co_od_info *info,
 			     enum co_od_writer reader, void *user_data)
