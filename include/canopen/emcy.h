@@ -139,7 +139,9 @@ struct co_emcy {
 	uint8_t can_state;
 #endif
 	/* Consumer. */
+#if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
 	struct co_rx cons_rx[CONFIG_CANOPEN_EMCY_CONSUMERS];
+#endif
 	co_emcy_ind_t ind;
 	void *ind_user_data;
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
@@ -205,7 +207,9 @@ uint8_t co_emcy_get_reg(struct co_node *node);
 /** @brief Counters of the EMCY producer. */
 void co_emcy_get_status(struct co_node *node, struct co_emcy_status *status);
 
-/** @brief Set the EMCY consumer indication (NULL removes it). */
+/** @brief Set the EMCY consumer indication (NULL removes it; never called when
+ * CONFIG_CANOPEN_EMCY_CONSUMERS is 0).
+ */
 void co_emcy_set_ind(struct co_node *node, co_emcy_ind_t cb, void *user_data);
 
 #ifdef __cplusplus

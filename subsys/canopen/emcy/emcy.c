@@ -324,6 +324,8 @@ static void inhibit_notify(struct co_od *od, const struct co_od_req *req, void *
 
 /* --- Consumer 1028h ----------------------------------------------------------------------- */
 
+/* Without consumer entries (CONFIG_CANOPEN_EMCY_CONSUMERS=0) nothing below is built. */
+#if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 /*
  * A node on two lines hears an EMCY on both (the producer sends it on both): the same frame
@@ -408,6 +410,7 @@ static void cons_notify(struct co_od *od, const struct co_od_req *req, void *use
 		cons_configure(node, sub - 1, (uint32_t)co_od_req_uint(req));
 	}
 }
+#endif /* CONFIG_CANOPEN_EMCY_CONSUMERS > 0 */
 
 /* --- Active errors ------------------------------------------------------------------------ */
 
@@ -678,6 +681,7 @@ static int emcy_init(struct co_node *node)
 			.notify = inhibit_notify,
 			.user_data = node,
 		},
+#if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
 		{
 			.index_first = IDX_CONSUMER,
 			.index_last = IDX_CONSUMER,
@@ -686,13 +690,16 @@ static int emcy_init(struct co_node *node)
 			.notify = cons_notify,
 			.user_data = node,
 		},
+#endif
 	};
 	int err;
 
 	co_timer_init(&em->inhibit_timer, inhibit_expired, &node->lock, node);
+#if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
 	for (int i = 0; i < CONFIG_CANOPEN_EMCY_CONSUMERS; i++) {
 		co_rx_init(&em->cons_rx[i], 0U, cons_rx, &node->lock, node);
 	}
+#endif
 	em->cob_id = COB_INVALID;
 #if defined(CONFIG_CANOPEN_EMCY_LINE_EVENTS)
 	line_events_init(node);
@@ -711,7 +718,6 @@ static void emcy_reset_comm(struct co_node *node)
 	struct co_emcy *em = &node->emcy;
 	struct co_od_info info;
 	uint8_t n = 0U;
-	uint8_t count;
 
 	flush_queue(em);
 	em->overflows = 0U;
@@ -740,7 +746,8 @@ static void emcy_reset_comm(struct co_node *node)
 #endif
 	update_reg(node);
 
-	count = (uint8_t)co_od_uint(&node->od, IDX_CONSUMER, 0, 0U);
+#if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
+	uint8_t count = (uint8_t)co_od_uint(&node->od, IDX_CONSUMER, 0, 0U);
 	if (count > CONFIG_CANOPEN_EMCY_CONSUMERS) {
 		LOG_WRN("%s: 1028h has %u entries, CONFIG_CANOPEN_EMCY_CONSUMERS=%d are served",
 			node->name, count, CONFIG_CANOPEN_EMCY_CONSUMERS);
@@ -752,6 +759,7 @@ static void emcy_reset_comm(struct co_node *node)
 
 		cons_configure(node, i, v);
 	}
+#endif
 }
 
 static void emcy_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)

@@ -307,6 +307,10 @@ ZTEST(co_emcy, test_consumer_1028h_indication_and_dlc_check)
 {
 	const uint8_t good[8] = {0x30, 0x81, 0x11, 1, 2, 3, 4, 5};
 
+	if (CONFIG_CANOPEN_EMCY_CONSUMERS < 2) {
+		ztest_test_skip(); /* test_consumer_entries_beyond_the_configured_count */
+	}
+
 	co_sim_rx(0x85, 8, good);
 	zassert_equal(t.n_ind, 0, "1028h entries invalid by default");
 	zassert_equal(co_sim_write(&t.node, 0x1028, 1, 0x85, 4), 0U);
@@ -335,6 +339,30 @@ ZTEST(co_emcy, test_consumer_1028h_indication_and_dlc_check)
 	co_sim_nmt(CO_NMT_CS_STOP, NODE_ID);
 	co_sim_rx(0xff, 8, good);
 	zassert_equal(t.n_ind, 2, "no EMCY consumption in Stopped");
+}
+
+/*
+ * The dictionary's 1028h has two entries: each is stored and read back, but heard only
+ * when CONFIG_CANOPEN_EMCY_CONSUMERS serves it (0: none).
+ */
+ZTEST(co_emcy, test_consumer_entries_beyond_the_configured_count)
+{
+	const uint8_t good[8] = {0x30, 0x81, 0x11, 1, 2, 3, 4, 5};
+
+	for (uint8_t sub = 1; sub <= 2U; sub++) {
+		uint32_t cob = 0x80U + sub;
+		uint32_t back = 0;
+		int before = t.n_ind;
+
+		zassert_equal(co_sim_write(&t.node, 0x1028, sub, cob, 4), 0U);
+		co_node_lock(&t.node);
+		zassert_ok(co_od_get_u32(co_node_od(&t.node), 0x1028, sub, &back));
+		co_node_unlock(&t.node);
+		zassert_equal(back, cob, "1028h:%u stored", sub);
+		co_sim_rx(cob, 8, good);
+		zassert_equal(t.n_ind - before, sub <= CONFIG_CANOPEN_EMCY_CONSUMERS ? 1 : 0,
+			      "1028h:%u heard only when served", sub);
+	}
 }
 
 /* Monitor node 5 with 100 ms, see its heartbeat once in Operational, then lose it. */
