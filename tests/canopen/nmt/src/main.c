@@ -261,6 +261,29 @@ ZTEST(co_nmt, test_heartbeat_consumer_ignores_guarding_frames_and_bad_lengths)
 	zassert_equal(t.n_hb, 1);
 }
 
+/*
+ * The dictionary's 1016h has four entries: each is stored, but only the first
+ * CONFIG_CANOPEN_HB_CONSUMERS are monitored (their heartbeats heard).
+ */
+ZTEST(co_nmt, test_consumer_entries_beyond_the_configured_count_are_not_monitored)
+{
+	for (uint8_t sub = 1; sub <= 4U; sub++) {
+		uint8_t remote = (uint8_t)(20U + sub);
+		uint32_t v = ((uint32_t)remote << 16) | 100U;
+		uint32_t back = 0;
+		int before = t.n_hb;
+
+		zassert_ok(co_sim_write(&t.node, 0x1016, sub, v, 4));
+		co_node_lock(&t.node);
+		zassert_ok(co_od_get_u32(co_node_od(&t.node), 0x1016, sub, &back));
+		co_node_unlock(&t.node);
+		zassert_equal(back, v, "1016h:%u stored", sub);
+		hb_from(remote, 0x05);
+		zassert_equal(t.n_hb - before, sub <= CONFIG_CANOPEN_HB_CONSUMERS ? 1 : 0,
+			      "1016h:%u monitored only when served", sub);
+	}
+}
+
 ZTEST(co_nmt, test_two_entries_for_one_node_are_refused)
 {
 	zassert_ok(co_sim_write(&t.node, 0x1016, 1, (9U << 16) | 100U, 4));
