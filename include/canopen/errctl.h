@@ -93,22 +93,24 @@ struct co_errctl {
 	/* Heartbeat producer. */
 	struct co_timer hb_timer;
 	uint16_t hb_period_ms;
+	/* co_hb_hold(): the heartbeat producer is silent. */
+	bool hb_held;
 	/* Heartbeat consumer: one entry per 1016h sub-index we serve. */
 	struct co_hb_entry hbc[CONFIG_CANOPEN_HB_CONSUMERS];
 	co_hb_ind_t hb_ind;
 	void *hb_user_data;
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 	/* Node guarding answers and life guarding. */
 	struct co_rx guard_rx;
 	struct co_timer life_timer;
 	uint16_t guard_time_ms;
 	uint8_t life_factor;
 	uint8_t toggle;
-	/* co_hb_hold(): the heartbeat producer is silent. */
-	bool hb_held;
 	bool guarded;
 	bool life_lost;
 	co_life_ind_t life_ind;
 	void *life_user_data;
+#endif
 };
 /** @endcond */
 
@@ -124,7 +126,9 @@ void co_hb_hold(struct co_node *node, bool hold);
 /** @brief Set the heartbeat consumer indication (NULL removes it). */
 void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data);
 
-/** @brief Set the life guarding indication (NULL removes it). */
+/** @brief Set the life guarding indication (NULL removes it; without
+ * CONFIG_CANOPEN_NODE_GUARDING it is never called).
+ */
 void co_life_set_ind(struct co_node *node, co_life_ind_t cb, void *user_data);
 
 /**

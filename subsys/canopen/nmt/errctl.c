@@ -66,7 +66,11 @@ static void send_state(struct co_node *node, uint8_t toggle, co_route_t route)
  */
 static void comm_error(struct co_node *node, uint8_t remote_id, bool event)
 {
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 	bool active = node->ec.life_lost;
+#else
+	bool active = false;
+#endif
 
 	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
 		active = active || node->ec.hbc[i].mon == HB_LOST;
@@ -271,6 +275,8 @@ static void hbc_notify(struct co_od *od, const struct co_od_req *req, void *user
 
 /* --- Node guarding and life guarding ------------------------------------------------------ */
 
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
+
 static void life_report(struct co_node *node, bool lost)
 {
 	struct co_event ev = {.type = CO_EV_LIFE, .life = {.lost = lost}};
@@ -334,6 +340,7 @@ static void guard_notify(struct co_od *od, const struct co_od_req *req, void *us
 	}
 	life_restart(node, now_of(node));
 }
+#endif /* CONFIG_CANOPEN_NODE_GUARDING */
 
 /* --- Node interface ----------------------------------------------------------------------- */
 
@@ -356,16 +363,17 @@ static int errctl_init(struct co_node *node)
 			.notify = hbc_notify,
 			.user_data = node,
 		},
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 		{
 			.index_first = IDX_GUARD_TIME,
 			.index_last = IDX_LIFE_FACTOR,
 			.notify = guard_notify,
 			.user_data = node,
 		},
+#endif
 	};
 
 	co_timer_init(&ec->hb_timer, hb_timer_handler, &node->lock, node);
-	co_timer_init(&ec->life_timer, life_timeout, &node->lock, node);
 	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
 		struct co_hb_entry *e = &ec->hbc[i];
 
@@ -373,7 +381,10 @@ static int errctl_init(struct co_node *node)
 		co_rx_init(&e->rx, 0U, hbc_rx, &node->lock, e);
 		co_timer_init(&e->timer, hbc_timeout, &node->lock, e);
 	}
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
+	co_timer_init(&ec->life_timer, life_timeout, &node->lock, node);
 	co_rx_init(&ec->guard_rx, 0U, guard_rx, &node->lock, node);
+#endif
 
 	return co_od_hooks_register(&node->od, hooks, ARRAY_SIZE(hooks));
 }
@@ -384,14 +395,16 @@ static void errctl_reset_comm(struct co_node *node)
 	uint8_t count = (uint8_t)co_od_uint(&node->od, IDX_HB_CONSUMER, 0, 0U);
 
 	co_timer_stop(&ec->hb_timer);
-	co_timer_stop(&ec->life_timer);
 	ec->hb_period_ms = (uint16_t)co_od_uint(&node->od, IDX_HB_PRODUCER, 0, 0U);
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
+	co_timer_stop(&ec->life_timer);
 	ec->guard_time_ms = (uint16_t)co_od_uint(&node->od, IDX_GUARD_TIME, 0, 0U);
 	ec->life_factor = (uint8_t)co_od_uint(&node->od, IDX_LIFE_FACTOR, 0, 0U);
 	/* The first guarding answer after a reset has the toggle bit 0. */
 	ec->toggle = 0U;
 	ec->guarded = false;
 	ec->life_lost = false;
+#endif
 
 	if (count > CONFIG_CANOPEN_HB_CONSUMERS) {
 		LOG_WRN("%s: 1016h has %u entries, CONFIG_CANOPEN_HB_CONSUMERS=%d are served",
@@ -404,10 +417,12 @@ static void errctl_reset_comm(struct co_node *node)
 
 		hbc_configure(node, i, v);
 	}
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 	if (co_node_rx_set_id(node, CO_LINE_DEFAULT, &ec->guard_rx,
 			      CO_NMT_EC_COB_ID + node->node_id) != 0) {
 		LOG_ERR("%s: no receive slot for node guarding", node->name);
 	}
+#endif
 }
 
 static void errctl_set_state(struct co_node *node, enum co_nmt_state from, enum co_nmt_state to)
@@ -416,7 +431,9 @@ static void errctl_set_state(struct co_node *node, enum co_nmt_state from, enum 
 
 	if (to == CO_NMT_INITIALISING) {
 		co_timer_stop(&ec->hb_timer);
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 		co_timer_stop(&ec->life_timer);
+#endif
 		for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
 			co_timer_stop(&ec->hbc[i].timer);
 		}
@@ -443,10 +460,17 @@ void co_hb_set_ind(struct co_node *node, co_hb_ind_t cb, void *user_data)
 
 void co_life_set_ind(struct co_node *node, co_life_ind_t cb, void *user_data)
 {
+#if defined(CONFIG_CANOPEN_NODE_GUARDING)
 	co_node_lock(node);
 	node->ec.life_ind = cb;
 	node->ec.life_user_data = user_data;
 	co_node_unlock(node);
+#else
+	/* Without guarding there is no life guarding event to indicate. */
+	ARG_UNUSED(node);
+	ARG_UNUSED(cb);
+	ARG_UNUSED(user_data);
+#endif
 }
 
 int co_hb_get_remote_state(struct co_node *node, uint8_t remote_id, enum co_nmt_state *state)

@@ -297,6 +297,9 @@ ZTEST(co_nmt, test_two_entries_for_one_node_are_refused)
 
 ZTEST(co_nmt, test_node_guarding_answers_toggle_and_only_without_heartbeat)
 {
+	if (!IS_ENABLED(CONFIG_CANOPEN_NODE_GUARDING)) {
+		ztest_test_skip(); /* test_guarding_only_with_node_guarding */
+	}
 	clear_sent();
 	co_sim_rx_flags(0x700 + NODE_ID, 1, NULL, CAN_FRAME_RTR);
 	zassert_equal(sim.n_sent, 0, "1017h != 0: heartbeat node, no guarding answers");
@@ -324,6 +327,9 @@ ZTEST(co_nmt, test_node_guarding_answers_toggle_and_only_without_heartbeat)
 
 ZTEST(co_nmt, test_life_guarding_event_and_resolution)
 {
+	if (!IS_ENABLED(CONFIG_CANOPEN_NODE_GUARDING)) {
+		ztest_test_skip(); /* test_guarding_only_with_node_guarding */
+	}
 	zassert_ok(co_sim_write(&t.node, 0x1017, 0, 0, 2));
 	zassert_ok(co_sim_write(&t.node, 0x100C, 0, 100, 2));
 	zassert_ok(co_sim_write(&t.node, 0x100D, 0, 3, 1));
@@ -348,9 +354,30 @@ ZTEST(co_nmt, test_life_guarding_event_and_resolution)
 
 ZTEST(co_nmt, test_stopped_node_keeps_error_control)
 {
+	if (!IS_ENABLED(CONFIG_CANOPEN_NODE_GUARDING)) {
+		ztest_test_skip(); /* test_guarding_only_with_node_guarding */
+	}
 	co_sim_nmt(CO_NMT_CS_STOP, NODE_ID);
 	zassert_ok(co_sim_write(&t.node, 0x1017, 0, 0, 2));
 	clear_sent();
 	co_sim_rx_flags(0x700 + NODE_ID, 1, NULL, CAN_FRAME_RTR);
 	assert_state_frame(0, 0x700 + NODE_ID, 0x04);
+}
+
+/*
+ * Guarding requests are answered, and their end is a life guarding event, only with
+ * CONFIG_CANOPEN_NODE_GUARDING; without it 100Ch/100Dh are plain objects.
+ */
+ZTEST(co_nmt, test_guarding_only_with_node_guarding)
+{
+	bool guarding = IS_ENABLED(CONFIG_CANOPEN_NODE_GUARDING);
+
+	zassert_ok(co_sim_write(&t.node, 0x1017, 0, 0, 2));
+	zassert_ok(co_sim_write(&t.node, 0x100C, 0, 100, 2));
+	zassert_ok(co_sim_write(&t.node, 0x100D, 0, 3, 1));
+	clear_sent();
+	co_sim_rx_flags(0x700 + NODE_ID, 1, NULL, CAN_FRAME_RTR);
+	zassert_equal(sim.n_sent, guarding ? 1 : 0, "answered only with guarding");
+	co_sim_run_until(sim.now + 400 * MS);
+	zassert_equal(t.n_life, guarding ? 1 : 0, "life guarding event only with guarding");
 }
