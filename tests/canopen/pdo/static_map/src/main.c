@@ -12,9 +12,12 @@
  * 2001h (U16); TPDO 0 valid on 180h+N mapping 2000h:05 (U8) and 2002h (U32).
  */
 
+#include <errno.h>
+
 #include <zephyr/ztest.h>
 
 #include <canopen/node.h>
+#include <canopen/pdo.h>
 #include <canopen/sdo_abort.h>
 
 #include "co_sim.h"
@@ -101,6 +104,10 @@ ZTEST(co_pdo_static_map, test_dictionary_mapping_in_effect)
 	const uint8_t d[3] = {0x5A, 0x34, 0x12};
 	uint16_t w = 0;
 
+	if (CONFIG_CANOPEN_PDO_MAP_ENTRIES < 2) {
+		ztest_test_skip(); /* test_mapping_longer_than_the_table_leaves_the_pdo_off */
+	}
+
 	co_sim_nmt(0x01, NODE_ID);
 	co_sim_rx(0x200 + NODE_ID, 3, d);
 	zassert_equal(get_u8(0x2000, 1), 0x5A);
@@ -108,4 +115,22 @@ ZTEST(co_pdo_static_map, test_dictionary_mapping_in_effect)
 	zassert_ok(co_od_get_u16(co_node_od(&t.node), 0x2001, 0, &w));
 	co_node_unlock(&t.node);
 	zassert_equal(w, 0x1234);
+}
+
+/*
+ * The dictionary's mappings have two entries each: with a table of fewer
+ * (CONFIG_CANOPEN_PDO_MAP_ENTRIES) the PDO stays off after the reset of communication, its
+ * frames neither received nor sent.
+ */
+ZTEST(co_pdo_static_map, test_mapping_longer_than_the_table_leaves_the_pdo_off)
+{
+	const bool fits = CONFIG_CANOPEN_PDO_MAP_ENTRIES >= 2;
+	const uint8_t d[3] = {0x6B, 0x34, 0x12};
+
+	co_sim_nmt(0x01, NODE_ID);
+	co_sim_rx(0x200 + NODE_ID, 3, d);
+	zassert_equal(get_u8(0x2000, 1), fits ? 0x6B : 0x00, "RPDO 1 on only when it fits");
+	sim.n_sent = 0;
+	zassert_equal(co_tpdo_send_req(&t.node, 0), fits ? 0 : -EINVAL);
+	zassert_equal(sim.n_sent, fits ? 1 : 0, "TPDO 1 on only when it fits");
 }
