@@ -1204,6 +1204,30 @@ static uint8_t map_load(struct co_node *node, bool rx, uint16_t num, uint8_t typ
 	return 0U;
 }
 
+/*
+ * What RPDOs and TPDOs read alike from their records at a reset of communication: type,
+ * event time and mapping. Returns the COB-ID, with the invalid bit when the node cannot
+ * serve the type (no SYNC) or hold the mapping: the PDO then stays off.
+ */
+static uint32_t comm_load(struct co_node *node, bool rx, uint16_t num, uint8_t *type,
+			  uint16_t *event_ms, struct co_pdo_map *map, uint8_t *mpdo)
+{
+	uint16_t comm = (rx ? IDX_RPDO_COMM : IDX_TPDO_COMM) + num;
+	uint32_t cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
+
+	*type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
+	if (!sync_type_served(*type)) {
+		LOG_ERR("%s: %cPDO %u is synchronous, the node has no SYNC; it stays off",
+			node->name, rx ? 'R' : 'T', num + 1U);
+		cob_id |= CO_PDO_COB_INVALID;
+	}
+	*event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
+	if (map_load(node, rx, num, *type, map, mpdo) != 0U) {
+		cob_id |= CO_PDO_COB_INVALID;
+	}
+	return cob_id;
+}
+
 static void pdo_reset_comm(struct co_node *node)
 {
 	struct co_pdo *pdo = &node->pdo;
@@ -1215,22 +1239,11 @@ static void pdo_reset_comm(struct co_node *node)
 #endif
 	for (uint16_t i = 0; i < CO_RPDOS; i++) {
 		struct co_rpdo *r = &pdo->rpdo[i];
-		uint16_t comm = IDX_RPDO_COMM + i;
 
 		if (!r->present) {
 			continue;
 		}
-		r->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
-		r->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
-		if (!sync_type_served(r->type)) {
-			LOG_ERR("%s: RPDO %u is synchronous, the node has no SYNC; it stays off",
-				node->name, i + 1U);
-			r->cob_id |= CO_PDO_COB_INVALID;
-		}
-		r->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
-		if (map_load(node, true, i, r->type, &r->map, &r->mpdo) != 0U) {
-			r->cob_id |= CO_PDO_COB_INVALID;
-		}
+		r->cob_id = comm_load(node, true, i, &r->type, &r->event_ms, &r->map, &r->mpdo);
 		rpdo_configure(r);
 	}
 	for (uint16_t i = 0; i < CO_TPDOS; i++) {
@@ -1240,19 +1253,9 @@ static void pdo_reset_comm(struct co_node *node)
 		if (!t->present) {
 			continue;
 		}
-		t->cob_id = (uint32_t)co_od_uint(&node->od, comm, SUB_COB_ID, CO_PDO_COB_INVALID);
-		t->type = (uint8_t)co_od_uint(&node->od, comm, SUB_TYPE, CO_PDO_TT_EVENT_PROF);
-		if (!sync_type_served(t->type)) {
-			LOG_ERR("%s: TPDO %u is synchronous, the node has no SYNC; it stays off",
-				node->name, i + 1U);
-			t->cob_id |= CO_PDO_COB_INVALID;
-		}
+		t->cob_id = comm_load(node, false, i, &t->type, &t->event_ms, &t->map, &t->mpdo);
 		t->inhibit_us = (uint32_t)co_od_uint(&node->od, comm, SUB_INHIBIT, 0U) * 100U;
-		t->event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
 		t->sync_start = (uint8_t)co_od_uint(&node->od, comm, SUB_SYNC_START, 0U);
-		if (map_load(node, false, i, t->type, &t->map, &t->mpdo) != 0U) {
-			t->cob_id |= CO_PDO_COB_INVALID;
-		}
 		cos_hooks_update(t);
 		tpdo_configure(t);
 	}
