@@ -1219,11 +1219,11 @@ static uint32_t comm_load(struct co_node *node, bool rx, uint16_t num, uint8_t *
 	if (!sync_type_served(*type)) {
 		LOG_ERR("%s: %cPDO %u is synchronous, the node has no SYNC; it stays off",
 			node->name, rx ? 'R' : 'T', num + 1U);
-		cob_id |= CO_PDO_COB_INVALID;
+		cob_id |= (uint32_t)CO_PDO_COB_INVALID;
 	}
 	*event_ms = (uint16_t)co_od_uint(&node->od, comm, SUB_EVENT, 0U);
 	if (map_load(node, rx, num, *type, map, mpdo) != 0U) {
-		cob_id |= CO_PDO_COB_INVALID;
+		cob_id |= (uint32_t)CO_PDO_COB_INVALID;
 	}
 	return cob_id;
 }
