@@ -657,12 +657,14 @@ static inline void stat_inc(uint32_t *counter)
 }
 
 /*
- * A frame from the bus. The common case, one receiver for an 11-bit id and no masked or
- * 29-bit receivers on the line, is looked up and called here; anything else goes through
- * co_line_dispatch_sel().
+ * A frame from the bus. With CONFIG_CANOPEN_LINE_RX_SHORTCUT the common case, one receiver
+ * for an 11-bit id and no masked or 29-bit receivers on the line, is looked up and called
+ * here; anything else (everything without the option) goes through co_line_dispatch_sel(),
+ * which does the same in more steps.
  */
 int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
 {
+#if defined(CONFIG_CANOPEN_LINE_RX_SHORTCUT)
 	uint32_t seq = LD_ACQ(&line->rx_seq);
 
 	if (likely((frame->flags & CAN_FRAME_IDE) == 0U && (seq & 1U) == 0U)) {
@@ -679,6 +681,7 @@ int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now
 			return 1;
 		}
 	}
+#endif
 	return co_line_dispatch_sel(line, frame, now_us, NULL, false);
 }
 
