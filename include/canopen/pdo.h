@@ -247,7 +247,8 @@ struct co_pdo {
  * A node on two lines hears each PDO twice; a frame with the same data as one of the last
  * CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH frames taken from the other line, within
  * CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US of it, is that frame's copy and is dropped, so the
- * application sees every value once. Always 0 without CONFIG_CANOPEN_REDUNDANCY.
+ * application sees every value once; a copy also ends the wait for the copies of the frames
+ * taken before it (a line keeps the order sent). Always 0 without CONFIG_CANOPEN_REDUNDANCY.
  */
 uint32_t co_pdo_rx_duplicates(struct co_node *node);
 

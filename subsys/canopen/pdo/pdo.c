@@ -315,7 +315,20 @@ static bool rpdo_duplicate(struct co_rpdo *r, const struct can_frame *frame, uin
 		if (!e->copied && e->line != line && e->dlc == frame->dlc && e->dlc != 0xffU &&
 		    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
 		    memcmp(frame->data, e->data, frame->dlc) == 0) {
-			e->copied = true;
+			/*
+			 * A line delivers one producer's frames in the order sent: the older
+			 * frames taken from the other line that this line has not copied yet, it
+			 * lost. They can have no copy any more, so a later value equal to one of
+			 * them is not mistaken for it.
+			 */
+			for (uint8_t j = 0; j <= k; j++) {
+				struct co_rpdo_taken *o =
+					&r->taken[(r->taken_next + j) % ARRAY_SIZE(r->taken)];
+
+				if (o->line != line) {
+					o->copied = true;
+				}
+			}
 			r->node->pdo.rx_duplicates++;
 			return true;
 		}

@@ -368,6 +368,49 @@ static uint8_t rpdo_value(void)
 	return v;
 }
 
+/*
+ * Each line carries the producer's frames in the order sent. The redundant line lost the copy
+ * of 11h and brought 22h's: 11h can have no copy any more, so the 11h the producer sends next
+ * (first on the redundant line, the default line about to fail) is a new value, not 11h's
+ * late copy (it was dropped as one before, and lost with the default line).
+ */
+ZTEST(co_redundancy, test_a_copy_in_order_ends_the_wait_for_older_copies)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	uint8_t v;
+
+	rx(D, 0x000, 2, start);
+	v = 0x11;
+	rx(D, 0x182, 1, &v);
+	run_until(t.now + 1 * MS);
+	v = 0x22;
+	rx(D, 0x182, 1, &v);
+	run_until(t.now + 1 * MS);
+	rx(R, 0x182, 1, &v);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 1, "22h's copy is dropped");
+	run_until(t.now + 1 * MS);
+	v = 0x11;
+	rx(R, 0x182, 1, &v);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 1, "the new 11h is no copy");
+	zassert_equal(rpdo_value(), 0x11);
+	/* Its copy on the default line, if it still comes, is one. */
+	rx(D, 0x182, 1, &v);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 2);
+}
+
+/* A loaded host holds one line's frames back for tens of milliseconds: still a copy. */
+ZTEST(co_redundancy, test_a_copy_150_ms_late_is_dropped)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	uint8_t v = 0x5A;
+
+	rx(D, 0x000, 2, start);
+	rx(D, 0x182, 1, &v);
+	run_until(t.now + 150 * MS);
+	rx(R, 0x182, 1, &v);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 1);
+}
+
 /* A cut controller's held frame, or frames a flood held up, come late on a failing line. */
 ZTEST(co_redundancy, test_pdo_frames_of_a_line_that_lost_a_heartbeat_are_not_taken)
 {
@@ -535,7 +578,7 @@ ZTEST(co_redundancy, test_emcy_copies_from_the_other_line_reach_the_consumer_onc
 	zassert_equal(t.n_emcy, 5, "two copies, one new");
 	/* A copy later than the window is a new emergency (the PDO copies' limit too). */
 	rx(D, 0x082, 8, e2);
-	run_until(t.now + 60 * MS);
+	run_until(t.now + CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US + 10 * MS);
 	rx(R, 0x082, 8, e2);
 	run_until(t.now + 1 * MS);
 	zassert_equal(t.n_emcy, 7);

@@ -438,11 +438,11 @@ static void tally(int slave, struct tally *t)
 
 /*
  * 1: report, not fail on, values delivered twice by chance. The duplicate filter matches a
- * copy within CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US (50 ms) of the frame it took, by receive
- * stamps; on a loaded host a bus or line thread late by more than that (or by more than the
- * 32 ms a 16-bit receive stamp reaches, after which a frame is stamped when it is handed
- * over) lets copies through: seen with load average 4.5 on two cores, 11 values of node 2
- * again on the redundant line 80-110 ms after the default line's, in the error-passive test.
+ * copy within CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US (250 ms) of the frame it took, by receive
+ * stamps, and the last CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH frames; on a loaded host a bus or
+ * line thread late by more than that lets copies through (with a 50 ms window: seen with
+ * load average 4.5 on two cores, 11 values of node 2 again on the redundant line 80-110 ms
+ * after the default line's, in the error-passive test).
  * The deterministic cases are strict: test_a_late_line_thread_delivers_no_value_twice (35 ms)
  * and test_copies_held_back_on_a_failed_line_are_not_delivered_again.
  */
