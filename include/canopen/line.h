@@ -261,8 +261,10 @@ struct co_line {
 	/* Frames handed to the driver whose TX completion has not run yet (co_line_stop()). */
 	atomic_t tx_inflight;
 
+#if defined(CONFIG_CANOPEN_LINE_SIM)
 	co_line_sink_t sink;
 	void *sink_user_data;
+#endif
 	co_line_event_cb_t event_cb;
 	void *event_user_data;
 	/* Listeners of the nodes on the line, in registration order. */
@@ -271,8 +273,10 @@ struct co_line {
 	atomic_t tx_overflow_pending;
 	atomic_t tx_error_pending;
 	struct co_line_stats stats;
+#if defined(CONFIG_CANOPEN_LINE_SIM)
 	/* Simulation mode: the time of the last co_line_rx()/co_line_process(). */
 	uint64_t sim_now;
+#endif
 	/* Nodes attached; from two on, frames a node sends reach the others (local delivery). */
 	uint8_t n_nodes;
 	struct co_line_member *members;
@@ -298,11 +302,13 @@ struct co_line {
  * @{
  */
 
+#if defined(CONFIG_CANOPEN_LINE_SIM)
 /**
  * @brief Initialise a line in simulation mode: frames sent go to @p sink.
  *
  * Nothing runs by itself: the caller feeds frames with co_line_rx() and time with
- * co_line_process(). Used by protocol unit tests on simulated time.
+ * co_line_process(). Used by protocol unit tests on simulated time. Only with
+ * CONFIG_CANOPEN_LINE_SIM.
  *
  * @param line Line to initialise (statically allocated by the caller).
  * @param name Name for logs; must outlive the line.
@@ -310,6 +316,7 @@ struct co_line {
  * @param user_data Passed to @p sink.
  */
 void co_line_init_sim(struct co_line *line, const char *name, co_line_sink_t sink, void *user_data);
+#endif
 
 /**
  * @brief Initialise a line bound to a CAN device.

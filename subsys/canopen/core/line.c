@@ -45,7 +45,25 @@ uint64_t co_line_now(void)
 
 uint64_t co_line_time(const struct co_line *line)
 {
-	return line->dev == NULL ? line->sim_now : co_line_now();
+#if defined(CONFIG_CANOPEN_LINE_SIM)
+	if (line->dev == NULL) {
+		return line->sim_now;
+	}
+#endif
+	return co_line_now();
+}
+
+/* Simulation: one thread drives the line, whose time is the latest it was given. */
+static inline void sim_advance(struct co_line *line, uint64_t now_us)
+{
+#if defined(CONFIG_CANOPEN_LINE_SIM)
+	if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
+		line->sim_now = now_us;
+	}
+#else
+	ARG_UNUSED(line);
+	ARG_UNUSED(now_us);
+#endif
 }
 
 const struct device *co_line_device(const struct co_line *line)
@@ -64,12 +82,14 @@ static void line_init_common(struct co_line *line, const char *name)
 	k_mutex_init(&line->tx_lock);
 }
 
+#if defined(CONFIG_CANOPEN_LINE_SIM)
 void co_line_init_sim(struct co_line *line, const char *name, co_line_sink_t sink, void *user_data)
 {
 	line_init_common(line, name);
 	line->sink = sink;
 	line->sink_user_data = user_data;
 }
+#endif
 
 int co_line_init(struct co_line *line, const char *name, const struct device *dev)
 {
@@ -672,10 +692,7 @@ int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now
 
 		if (rx != NULL && LD_ACQ(&rx->next) == NULL && LD_ACQ(&line->others) == NULL &&
 		    LD_ACQ(&line->rx_seq) == seq) {
-			if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
-				/* Simulation: one thread drives the line. */
-				line->sim_now = now_us;
-			}
+			sim_advance(line, now_us);
 			stat_inc(&line->stats.rx_frames);
 			rx_call(line, rx, frame, now_us);
 			return 1;
@@ -702,10 +719,7 @@ int co_line_dispatch_sel(struct co_line *line, const struct can_frame *frame, ui
 	uint32_t seq = LD_ACQ(&line->rx_seq);
 	int n = -1;
 
-	if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
-		/* Simulation: one thread drives the line. */
-		line->sim_now = now_us;
-	}
+	sim_advance(line, now_us);
 	if (likely((seq & 1U) == 0U)) {
 		n = rx_collect(line, frame, lock, only, batch, RX_WALK_MAX);
 	}
@@ -851,15 +865,13 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 	struct co_timer *t;
 	uint32_t gen = 0U;
 
-	if (line->dev == NULL) {
+	if (co_line_is_sim(line)) {
 		k_mutex_lock(&line->lock, K_FOREVER);
-		if (co_time_before_eq(line->sim_now, now_us)) {
-			line->sim_now = now_us;
-		}
+		sim_advance(line, now_us);
 		k_mutex_unlock(&line->lock);
 	}
 
-	if (IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) && line->dev == NULL) {
+	if (IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) && co_line_is_sim(line)) {
 		co_line_local_drain(line);
 	}
 
@@ -889,7 +901,7 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 	}
 	co_line_tx_drain(line);
 	co_line_report_deferred(line);
-	if (line->dev == NULL && k_msgq_num_used_get(&line->rxq) > 0U) {
+	if (co_line_is_sim(line) && k_msgq_num_used_get(&line->rxq) > 0U) {
 		/* Local frames sent by the handlers above are due at once. */
 		return now_us;
 	}
@@ -898,13 +910,25 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 
 /* --- Transmission ------------------------------------------------------------------------ */
 
+/* A simulated line's send: its sink (never called without CONFIG_CANOPEN_LINE_SIM). */
+static inline int sim_sink(struct co_line *line, const struct can_frame *frame)
+{
+#if defined(CONFIG_CANOPEN_LINE_SIM)
+	return line->sink(line, frame, line->sink_user_data);
+#else
+	ARG_UNUSED(line);
+	ARG_UNUSED(frame);
+	return -ENODEV;
+#endif
+}
+
 /* Hand one frame to the driver or the sink. Returns 0, -EAGAIN (back-pressure) or an error. */
 static inline int tx_submit(struct co_line *line, const struct can_frame *frame)
 {
 	int err;
 
-	if (line->dev == NULL) {
-		err = line->sink(line, frame, line->sink_user_data);
+	if (co_line_is_sim(line)) {
+		err = sim_sink(line, frame);
 	} else if (!atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
 		/* Not started yet (a node's boot-up before co_line_start()): wait in the queue. */
 		err = -EAGAIN;

@@ -26,6 +26,15 @@
  */
 #define CO_LINE_F_BUS_OFF      6
 
+/*
+ * A simulated line (co_line_init_sim()): no CAN device, time driven by the caller. Without
+ * CONFIG_CANOPEN_LINE_SIM every line has a device and the simulation branches are left out.
+ */
+static inline bool co_line_is_sim(const struct co_line *line)
+{
+	return IS_ENABLED(CONFIG_CANOPEN_LINE_SIM) && line->dev == NULL;
+}
+
 /* Wake the line thread so it re-reads its deadline (no-op in simulation). */
 void co_line_wake(struct co_line *line);
 

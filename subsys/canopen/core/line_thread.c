@@ -45,7 +45,7 @@ void co_line_wake(struct co_line *line)
 {
 	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
 
-	if (line->dev == NULL || !atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
+	if (co_line_is_sim(line) || !atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
 		return;
 	}
 	/* The line thread re-reads its deadline before sleeping anyway. Compared by address:
