@@ -330,7 +330,9 @@ static void inhibit_notify(struct co_od *od, const struct co_od_req *req, void *
 /*
  * A node on two lines hears an EMCY on both (the producer sends it on both): the same frame
  * from the other line within the PDO copies' window is the copy of one taken there, each
- * taken frame has one copy. A repeat on the same line is a new emergency.
+ * taken frame has one copy, and a copy ends the wait for the copies of that producer's older
+ * frames (a line keeps the order sent: it lost them), as for RPDOs. A repeat on the same line
+ * is a new emergency.
  */
 static bool cons_copy(struct co_emcy *em, uint8_t line, const struct can_frame *frame,
 		      uint64_t now_us)
@@ -345,7 +347,13 @@ static bool cons_copy(struct co_emcy *em, uint8_t line, const struct can_frame *
 		    em->taken[i].id == frame->id &&
 		    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
 		    memcmp(em->taken[i].data, frame->data, 8) == 0) {
-			em->taken[i].copied = true;
+			for (uint8_t j = 0; j <= k; j++) {
+				uint8_t o = (uint8_t)((em->taken_next + j) % ARRAY_SIZE(em->taken));
+
+				if (em->taken[o].line != line && em->taken[o].id == frame->id) {
+					em->taken[o].copied = true;
+				}
+			}
 			return true;
 		}
 	}

@@ -584,6 +584,30 @@ ZTEST(co_redundancy, test_emcy_copies_from_the_other_line_reach_the_consumer_onc
 	zassert_equal(t.n_emcy, 7);
 }
 
+/* As for RPDOs: a copy in order ends the wait for the copies of the producer's older EMCYs. */
+ZTEST(co_redundancy, test_emcy_copy_in_order_ends_the_wait_for_older_copies)
+{
+	const uint8_t e1[8] = {0x00, 0x50, 0x01, 1, 2, 3, 4, 5};
+	const uint8_t e2[8] = {0x00, 0x42, 0x09};
+
+	run_until(10 * MS);
+	rx(D, 0x082, 8, e1);
+	rx(D, 0x082, 8, e2);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 2);
+	/* The redundant line lost e1's copy and brings e2's. */
+	rx(R, 0x082, 8, e2);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 2, "e2's copy");
+	/* The same emergency as e1 again, first on the redundant line: a new one. */
+	rx(R, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 3, "not e1's late copy");
+	rx(D, 0x082, 8, e1);
+	run_until(t.now + 1 * MS);
+	zassert_equal(t.n_emcy, 3, "its copy");
+}
+
 ZTEST(co_redundancy, test_extended_frames_of_the_redundant_line_reach_the_node)
 {
 	struct can_frame f = {.id = 0x1234567, .dlc = 1, .flags = CAN_FRAME_IDE};
