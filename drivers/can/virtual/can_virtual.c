@@ -44,6 +44,8 @@ LOG_MODULE_REGISTER(can_virtual, CONFIG_CAN_LOG_LEVEL);
 #define CV_MAX_FILTERS   CONFIG_CAN_VIRTUAL_MAX_FILTERS
 #define CV_DELAY_SIZE    CONFIG_CAN_VIRTUAL_DELAY_QUEUE_SIZE
 #define CV_MAX_FAULTS    8
+/* State changes a controller holds for its callback; more than two at once only in a race. */
+#define CV_STATE_QUEUE   4U
 #define CV_NEVER         UINT64_MAX
 /* Bus-off ends after 128 occurrences of 11 consecutive recessive bits (ISO 11898-1). */
 #define CV_RECOVERY_BITS (128U * 11U)
@@ -62,6 +64,11 @@ struct cv_tx {
 	void *user_data;
 	uint64_t seq;
 	uint64_t queued_ns;
+};
+
+struct cv_state_change {
+	enum can_state state;
+	struct can_bus_err_cnt cnt;
 };
 
 struct cv_config {
@@ -90,6 +97,10 @@ struct cv_data {
 	struct k_sem tx_slots;
 	/* given when a bus-off ends, for can_recover() */
 	struct k_sem recovered;
+	/* State changes not yet passed to the callback, oldest first (cv_notify_run()). */
+	struct cv_state_change changes[CV_STATE_QUEUE];
+	uint8_t changes_head;
+	uint8_t n_changes;
 	/* Held while a state-change callback runs and while it is replaced (before cv_lock). */
 	struct k_mutex state_cb_lock;
 	/* guarded by rx_lock */
@@ -213,13 +224,9 @@ static struct can_bus_err_cnt cv_err_cnt(const struct cv_data *d)
 	return cnt;
 }
 
-/* Pending state-change notifications, collected under cv_lock and called after it. */
+/* A controller with state changes to pass to its callback once cv_lock is released. */
 struct cv_notify {
 	const struct device *dev;
-	enum can_state state;
-	struct can_bus_err_cnt cnt;
-	can_state_change_callback_t cb;
-	void *user_data;
 };
 
 static void cv_set_state_locked(struct cv_data *d, enum can_state state, uint16_t tec, uint8_t rec,
@@ -232,30 +239,60 @@ static void cv_set_state_locked(struct cv_data *d, enum can_state state, uint16_
 	d->rec = rec;
 	n->dev = NULL;
 	if (changed && d->common.started) {
+		struct cv_state_change *c;
+
+		if (d->n_changes < CV_STATE_QUEUE) {
+			c = &d->changes[(d->changes_head + d->n_changes) % CV_STATE_QUEUE];
+			d->n_changes++;
+		} else {
+			/* Full: the newest entry becomes this state, so the last state still
+			 * arrives. */
+			c = &d->changes[(d->changes_head + CV_STATE_QUEUE - 1U) % CV_STATE_QUEUE];
+		}
+		c->state = state;
+		c->cnt = cv_err_cnt(d);
 		n->dev = d->dev;
-		n->state = state;
-		n->cnt = cv_err_cnt(d);
-		n->cb = d->common.state_change_cb;
-		n->user_data = d->common.state_change_cb_user_data;
 	}
 }
 
 /*
- * Called under the controller's state_cb_lock with the callback read again there, so that once
- * can_set_state_change_callback() has returned the callback it replaced never runs.
+ * Passes the controller's queued state changes to its callback, oldest first. Two threads
+ * that changed the state (a test injecting one, the bus thread ending a bus-off) both come
+ * here after releasing cv_lock; whichever takes state_cb_lock first delivers every change
+ * queued so far, in the order they happened, so the callback never sees a later state before
+ * an earlier one. The callback is read again under state_cb_lock: once
+ * can_set_state_change_callback() has returned, the one it replaced never runs.
  */
 static void cv_notify_run(const struct cv_notify *n)
 {
-	if (n->dev != NULL && n->cb != NULL) {
-		struct cv_data *d = cv_data(n->dev);
+	struct cv_data *d;
 
-		(void)k_mutex_lock(&d->state_cb_lock, K_FOREVER);
-		if (d->common.state_change_cb != NULL) {
-			d->common.state_change_cb(n->dev, n->state, n->cnt,
-						  d->common.state_change_cb_user_data);
-		}
-		(void)k_mutex_unlock(&d->state_cb_lock);
+	if (n->dev == NULL) {
+		return;
 	}
+	d = cv_data(n->dev);
+	(void)k_mutex_lock(&d->state_cb_lock, K_FOREVER);
+	for (;;) {
+		struct cv_state_change c;
+		can_state_change_callback_t cb;
+		void *user_data;
+
+		(void)k_mutex_lock(&cv_lock, K_FOREVER);
+		if (d->n_changes == 0U) {
+			(void)k_mutex_unlock(&cv_lock);
+			break;
+		}
+		c = d->changes[d->changes_head];
+		d->changes_head = (uint8_t)((d->changes_head + 1U) % CV_STATE_QUEUE);
+		d->n_changes--;
+		cb = d->common.state_change_cb;
+		user_data = d->common.state_change_cb_user_data;
+		(void)k_mutex_unlock(&cv_lock);
+		if (cb != NULL) {
+			cb(n->dev, c.state, c.cnt, user_data);
+		}
+	}
+	(void)k_mutex_unlock(&d->state_cb_lock);
 }
 
 /* Completed or aborted transmissions, collected under cv_lock and called after it. */

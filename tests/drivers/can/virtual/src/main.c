@@ -785,4 +785,69 @@ ZTEST(can_virtual, test_realtime_bus_off_recovers)
 	zassert_equal(states[1], CAN_STATE_ERROR_ACTIVE);
 }
 
+/* A state callback that holds the first change it gets until the test lets it go. */
+static K_SEM_DEFINE(held_cb_entered, 0, 1);
+static K_SEM_DEFINE(held_cb_release, 0, 1);
+
+static void holding_state_cb(const struct device *dev, enum can_state state,
+			     struct can_bus_err_cnt cnt, void *user_data)
+{
+	state_cb(dev, state, cnt, user_data);
+	if (n_states == 1) {
+		k_sem_give(&held_cb_entered);
+		(void)k_sem_take(&held_cb_release, K_SECONDS(5));
+	}
+}
+
+static void set_state_thread(void *p1, void *p2, void *p3)
+{
+	(void)can_virtual_set_state(c[0], (enum can_state)(intptr_t)p1);
+}
+
+static K_THREAD_STACK_ARRAY_DEFINE(setter_stacks, 2, 4096);
+static struct k_thread setters[2];
+
+/*
+ * Three changes that race for the callback: error passive (its callback still running), a
+ * bus-off injected by another thread, and the bus thread's automatic recovery 1 408 bit times
+ * later. The callback must see them in the order they happened: a recovery reported before
+ * its bus-off would leave a CANopen line believing it is still bus-off.
+ */
+ZTEST(can_virtual, test_realtime_state_changes_arrive_in_order)
+{
+	can_set_state_change_callback(c[0], holding_state_cb, NULL);
+	k_sem_reset(&held_cb_entered);
+	k_sem_reset(&held_cb_release);
+	k_thread_create(&setters[0], setter_stacks[0], K_THREAD_STACK_SIZEOF(setter_stacks[0]),
+			set_state_thread, (void *)(intptr_t)CAN_STATE_ERROR_PASSIVE, NULL, NULL, 0,
+			0, K_NO_WAIT);
+	zassert_ok(k_sem_take(&held_cb_entered, K_SECONDS(5)));
+
+	k_thread_create(&setters[1], setter_stacks[1], K_THREAD_STACK_SIZEOF(setter_stacks[1]),
+			set_state_thread, (void *)(intptr_t)CAN_STATE_BUS_OFF, NULL, NULL, 0, 0,
+			K_NO_WAIT);
+	/* Wait for the bus-off and then for the recovery that ends it (both not reported yet). */
+	enum can_state now = CAN_STATE_ERROR_PASSIVE;
+
+	for (int i = 0; i < 500 && now != CAN_STATE_BUS_OFF; i++) {
+		zassert_ok(can_get_state(c[0], &now, NULL));
+		k_usleep(100);
+	}
+	zassert_equal(now, CAN_STATE_BUS_OFF, "the bus-off was injected");
+	for (int i = 0; i < 500 && now != CAN_STATE_ERROR_ACTIVE; i++) {
+		k_msleep(1);
+		zassert_ok(can_get_state(c[0], &now, NULL));
+	}
+	zassert_equal(now, CAN_STATE_ERROR_ACTIVE, "the bus-off recovered by itself");
+	zassert_equal(n_states, 1, "only the first change has reached the callback");
+
+	k_sem_give(&held_cb_release);
+	zassert_ok(k_thread_join(&setters[0], K_SECONDS(5)));
+	zassert_ok(k_thread_join(&setters[1], K_SECONDS(5)));
+	zassert_equal(n_states, 3, "every change is reported (%d)", n_states);
+	zassert_equal(states[0], CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(states[1], CAN_STATE_BUS_OFF);
+	zassert_equal(states[2], CAN_STATE_ERROR_ACTIVE);
+}
+
 #endif
