@@ -580,29 +580,38 @@ static uint32_t case_number;
  * driver handed it over later (its bus thread ran late on a loaded host) the line could not
  * know of it: the host, not the stack, was late. Returns true in that case.
  */
-static bool host_late_for_sct(const struct log_rec *log, int n, uint32_t first_ev)
+/* The first safe-state event since @p first_ev (not Operational apart), if any. */
+static bool first_safe_event(uint32_t first_ev, struct ev_rec *out)
 {
-	const struct log_rec *inverted = NULL;
 	bool found = false;
-	uint64_t sct_at = 0U;
 
-	for (int i = 1; i < n && inverted == NULL; i++) {
-		if (log[i].id == COB2 && log[i - 1].id == COB1) {
-			inverted = &log[i];
-		}
-	}
 	co_node_lock(&consumer);
 	for (uint32_t c = first_ev; c < n_events && !found; c++) {
 		const struct ev_rec *e = &events[c % MAX_EV];
 
-		if (e->safe && e->reason == CO_SRDO_R_SCT) {
-			sct_at = e->time_us;
+		if (e->safe && e->reason != CO_SRDO_R_NOT_OPERATIONAL) {
+			*out = *e;
 			found = true;
 		}
 	}
 	co_node_unlock(&consumer);
-	/* done_us 0: not even handed over yet. */
-	return found && inverted != NULL && (inverted->done_us == 0U || inverted->done_us > sct_at);
+	return found;
+}
+
+/*
+ * A frame that arrived before @p deadline_us but reached the consumer's line after it (done_us
+ * 0: not even handed over yet): the host, not the bus, let the consumer's timer run first.
+ */
+static const struct log_rec *handed_over_late(const struct log_rec *log, int n,
+					      uint64_t deadline_us)
+{
+	for (int i = 0; i < n; i++) {
+		if (log[i].t_us <= deadline_us &&
+		    (log[i].done_us == 0U || log[i].done_us > deadline_us)) {
+			return &log[i];
+		}
+	}
+	return NULL;
 }
 
 enum outcome {
@@ -639,6 +648,7 @@ static enum outcome run_case(enum fault_class fc, uint8_t byte, uint8_t bit)
 	struct replay rp;
 	uint8_t have_n[FRAME_LEN], have_i[FRAME_LEN];
 	enum co_srdo_reason reason;
+	const struct log_rec *late;
 	uint64_t t_start, t_arm, t_seen, t_fault;
 	uint32_t cursor, first_ev, written, extra;
 	int state, n;
@@ -667,11 +677,25 @@ static enum outcome run_case(enum fault_class fc, uint8_t byte, uint8_t bit)
 		if (n < 2 || log[1].t_us > t_start + SCT_US) {
 			DISTURBED("the producer's first pair came after SCT");
 		}
-		if (host_late_for_sct(log, n, first_ev)) {
-			DISTURBED("the first pair reached the consumer's line after its SCT timer "
-				  "ran");
+		if (!first_safe_event(first_ev, &fault)) {
+			MISS("the consumer did not become valid, nor safe (%d frames logged)", n);
 		}
-		MISS("the consumer did not become valid");
+		/* Safe before its first pair: right if the frames call for it (a producer starved
+		 * between its two frames past SRVT, or past SCT), or the host held a frame back.
+		 */
+		replay_log(log, n, &rp);
+		if (rp.good == 0U && rp.reason == fault.reason) {
+			DISTURBED("the first frames call for %s", reason_name(rp.reason));
+		}
+		late = handed_over_late(log, n, fault.time_us);
+		if ((fault.reason == CO_SRDO_R_SCT || fault.reason == CO_SRDO_R_SRVT) &&
+		    late != NULL) {
+			DISTURBED("a frame before the %s deadline reached the line after it",
+				  reason_name(fault.reason));
+		}
+		MISS("the consumer went safe (%s) before its first pair; the frames call for %s "
+		     "(%d logged, %u good pairs)",
+		     reason_name(fault.reason), reason_name(rp.reason), n, rp.good);
 	}
 
 	if (valid.time_us < t_start) {
