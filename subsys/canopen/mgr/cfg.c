@@ -108,7 +108,7 @@ static void slot_release(struct co_cfg *cfg, struct co_cfg_slot *s)
 		/* Everything after it, including a value being received. */
 		uint32_t end = cfg->pool_used + (cfg->wr_slot != NULL ? cfg->wr_len : 0U);
 
-		memmove(cfg->pool + off, cfg->pool + off + len, end - off - len);
+		(void)memmove(cfg->pool + off, cfg->pool + off + len, end - off - len);
 		cfg->pool_used -= len;
 		for (int k = 0; k < 2; k++) {
 			struct co_cfg_slot *t = k == 0 ? cfg->cdcf : cfg->dcf;
@@ -305,6 +305,8 @@ static uint32_t prov_read(const struct co_od_provider *p, const struct co_od_inf
 			v = cfg->date[info->sub - 1U];
 		} else if (info->index == CO_CFG_INDEX_TIME) {
 			v = cfg->time[info->sub - 1U];
+		} else {
+			/* 1F25h (configure request): reads as 0, its write is the request. */
 		}
 		co_od_le_put(tmp, 4, v);
 		total = 4;
@@ -312,7 +314,7 @@ static uint32_t prov_read(const struct co_od_provider *p, const struct co_od_inf
 	*len = 0;
 	if (offset < total) {
 		*len = MIN(cap, (size_t)(total - offset));
-		memcpy(buf, src + offset, *len);
+		(void)memcpy(buf, src + offset, *len);
 	}
 	return 0;
 }
@@ -342,13 +344,15 @@ static uint32_t stream_write(struct co_cfg *cfg, const struct co_od_info *info, 
 	} else if (cfg->wr_slot != s || offset != cfg->wr_len) {
 		wr_drop(cfg);
 		return CO_SDO_AB_GENERAL;
+	} else {
+		/* The next chunk of the transfer under way. */
 	}
 	if (len > CO_CFG_POOL_SIZE - cfg->pool_used - cfg->wr_len) {
 		wr_drop(cfg);
 		return CO_SDO_AB_OUT_OF_MEM;
 	}
 	if (len > 0U) {
-		memcpy(cfg->pool + cfg->pool_used + cfg->wr_len, data, len);
+		(void)memcpy(cfg->pool + cfg->pool_used + cfg->wr_len, data, len);
 		cfg->wr_len += (uint32_t)len;
 	}
 	if (!last) {
@@ -393,6 +397,8 @@ static uint32_t prov_write(const struct co_od_provider *p, const struct co_od_in
 		cfg->date[info->sub - 1U] = get_u32(data);
 	} else if (info->index == CO_CFG_INDEX_TIME) {
 		cfg->time[info->sub - 1U] = get_u32(data);
+	} else {
+		/* 1F25h: see below. */
 	}
 	/* 1F25h is carried out by its validate hook and never stored. */
 	return 0;
@@ -780,7 +786,7 @@ int co_cfg_init(struct co_cfg *cfg, struct co_node *node)
 	if (cfg == NULL || node == NULL) {
 		return -EINVAL;
 	}
-	memset(cfg, 0, sizeof(*cfg));
+	(void)memset(cfg, 0, sizeof(*cfg));
 	cfg->node = node;
 	cfg->prov = (struct co_od_provider){
 		.api = &prov_api,

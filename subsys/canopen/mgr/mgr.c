@@ -46,8 +46,8 @@ struct co_mgr_slave *co_mgr_slot_get(struct co_mgr *m, uint8_t id)
 			s->status = CO_MGR_ST_NONE;
 			s->last_status = CO_MGR_ST_NONE;
 			s->last_read_mask = 0U;
-			memset(s->last_ident, 0, sizeof(s->last_ident));
-			memset(&s->last_err, 0, sizeof(s->last_err));
+			(void)memset(s->last_ident, 0, sizeof(s->last_ident));
+			(void)memset(&s->last_err, 0, sizeof(s->last_err));
 			s->nmt_state = 0U;
 			s->rep_state = 0U;
 			return s;
@@ -115,7 +115,7 @@ static int mgr_init(struct co_node *node)
 {
 	struct co_mgr *m = &node->mgr;
 
-	memset(m, 0, sizeof(*m));
+	(void)memset(m, 0, sizeof(*m));
 	m->node = node;
 	co_timer_init(&m->nmt_timer, co_mgr_nmt_timer_handler, &node->lock, m);
 	co_timer_init(&m->start_timer, co_mgr_start_timer_handler, &node->lock, m);

@@ -86,7 +86,7 @@ static uint8_t upload(struct co_mgr_slave *s, uint16_t index, uint8_t sub)
 {
 	int err;
 
-	memset(s->buf, 0, sizeof(s->buf));
+	(void)memset(s->buf, 0, sizeof(s->buf));
 	s->sdo_pending = true;
 	s->xfer_index = index;
 	s->xfer_sub = sub;
@@ -432,7 +432,7 @@ static uint8_t st_restore(struct co_mgr_slave *s)
 	if (sub == 0U) {
 		return CO_MGR_STEP_DOWNLOAD;
 	}
-	memcpy(s->load, sig_load, sizeof(s->load));
+	(void)memcpy(s->load, sig_load, sizeof(s->load));
 	return download(s, IDX_RESTORE, sub, s->load, sizeof(s->load));
 }
 
@@ -703,7 +703,7 @@ static void publish(struct co_mgr_slave *s)
 {
 	s->last_status = s->status;
 	s->last_read_mask = s->read_mask;
-	memcpy(s->last_ident, s->ident, sizeof(s->last_ident));
+	(void)memcpy(s->last_ident, s->ident, sizeof(s->last_ident));
 	s->last_err = s->err;
 }
 
@@ -861,8 +861,8 @@ static void boot_attempt(struct co_mgr_slave *s)
 	s->cfg_wait = false;
 	s->sdo_wait = false;
 	/* The working record; co_mgr_get_boot() shows the last finished one until boot_end(). */
-	memset(&s->err, 0, sizeof(s->err));
-	memset(s->ident, 0, sizeof(s->ident));
+	(void)memset(&s->err, 0, sizeof(s->err));
+	(void)memset(s->ident, 0, sizeof(s->ident));
 	co_mgr_ec_stop(s);
 	if (co_sdo_cli_busy(co_mgr_cli(s))) {
 		s->sdo_pending = false;

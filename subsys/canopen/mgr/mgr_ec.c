@@ -162,6 +162,8 @@ void co_mgr_ec_timer_handler(struct co_timer *timer, uint64_t now_us)
 		s->ec_lost = false;
 	} else if (s->guard_missed < 0xffU) {
 		s->guard_missed++;
+	} else {
+		/* Saturated: already far past the life time factor. */
 	}
 	if (s->guard_missed >= s->guard_rf) {
 		ec_event(s, CO_MGR_EC_GUARD_LOST);
@@ -296,6 +298,10 @@ void co_mgr_ec_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_
 	} else if (s->ec_lost && s->hb_ms != 0U && !s->booting) {
 		/* Heartbeat back after a loss: monitor again. */
 		co_mgr_hb_start(s, now_us);
+	} else {
+		/* A guarding reply, or a heartbeat not monitored (none configured, or its
+		 * boot watches it).
+		 */
 	}
 	if (s->hb_on) {
 		line_hb(s, now_us);

@@ -618,6 +618,8 @@ static int fm_event(struct co_node *node, const struct co_event *ev, void *user_
 		} else {
 			/* Warning or passive: still on the bus. */
 		}
+	} else {
+		/* Other NMT states, other lines, other line events: nothing to do. */
 	}
 	return 0;
 }

@@ -188,8 +188,8 @@ static int on_event(struct co_node *node, const struct co_event *ev, void *user_
 
 	if (ev->type == CO_EV_NMT_RESET) {
 		/* A new startup: every slave may be searched again. */
-		memset(l->searched, 0, sizeof(l->searched));
-		memset(l->pending, 0, sizeof(l->pending));
+		(void)memset(l->searched, 0, sizeof(l->searched));
+		(void)memset(l->pending, 0, sizeof(l->pending));
 		return 0;
 	}
 	id = ev->boot.node_id;

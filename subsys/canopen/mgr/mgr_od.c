@@ -85,6 +85,8 @@ static uint32_t req_nmt_validate(struct co_od *od, struct co_od_req *req, void *
 			}
 		} else if (co_mgr_nmt_queue(m, cs, 0U, true) != 0) {
 			return CO_SDO_AB_DATA_DEV_STATE;
+		} else {
+			/* The broadcast is queued. */
 		}
 		return CO_OD_HANDLED;
 	}

@@ -529,6 +529,8 @@ static void undo(struct co_mgr *m)
 	} else if (d->srv_num != 0U) {
 		add_wr(m, d->slave, IDX_SRV_PAR + d->srv_num, 1U, COB_INVALID, 4U);
 		add_wr(m, d->slave, IDX_SRV_PAR + d->srv_num, 2U, COB_INVALID, 4U);
+	} else {
+		/* No server of the slave was configured for it: nothing to undo there. */
 	}
 	add_status(m, d->srd, 0U);
 	d->op = OP_WRITE;
@@ -905,7 +907,7 @@ static void next(struct co_mgr *m)
 		if (d->n_q > 0U) {
 			struct co_mgr_sdom_req q = d->q[0];
 
-			memmove(&d->q[0], &d->q[1], (d->n_q - 1U) * sizeof(d->q[0]));
+			(void)memmove(&d->q[0], &d->q[1], (d->n_q - 1U) * sizeof(d->q[0]));
 			d->n_q--;
 			if (q.kind == IDX_REL_SDO) {
 				release_begin(m, q.val);
@@ -985,6 +987,8 @@ static uint32_t req_validate(struct co_od *od, struct co_od_req *req, void *user
 		code = 0x04U;
 	} else if (conn_free(m) == 0U || (default_taken(m, slave) && !pool_find(m, pair))) {
 		code = 0x02U;
+	} else {
+		/* A connection can be made: code stays 0. */
 	}
 	if (code != 0U) {
 		/* The failure status is written later by the queue: kind = the error code. */

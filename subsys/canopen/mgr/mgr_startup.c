@@ -158,6 +158,8 @@ void co_mgr_startup_boot_ended(struct co_mgr_slave *s, bool mandatory, uint64_t 
 		} else if (s->status == CO_MGR_ST_B) {
 			/* Optional slaves are polled in the background (§10 #9). */
 			co_mgr_boot_retry(s);
+		} else {
+			/* An optional slave's other errors end its boot (reported already). */
 		}
 	}
 	startup_check(m);
@@ -208,6 +210,8 @@ static void startup_begin(struct co_mgr *m)
 		} else if ((su & ~(uint32_t)SU_FLYING) == SU_START_ALL) {
 			/* 02h: start the network only if no master-capable device answers. */
 			co_mgr_fm_begin(m);
+		} else {
+			/* A slave that waits for a master's start command. */
 		}
 #endif
 		return;

@@ -153,7 +153,7 @@ static int boot_select(struct co_pgm *pg)
 	pg->pend_slot = -1;
 	pg->dl_slot = -1;
 	pg->running = false;
-	memset(&pg->run, 0, sizeof(pg->run));
+	(void)memset(&pg->run, 0, sizeof(pg->run));
 	for (uint8_t slot = 0; slot < 2U; slot++) {
 		struct co_pgm_image_info info;
 		uint32_t seq;
@@ -218,7 +218,7 @@ static uint32_t dl_begin(struct co_pgm *pg)
 	pg->dl_slot = (int8_t)slot;
 	pg->dl_crc = 0U;
 	pg->dl_hdr_ok = false;
-	memset(&pg->dl, 0, sizeof(pg->dl));
+	(void)memset(&pg->dl, 0, sizeof(pg->dl));
 	return 0;
 }
 
@@ -230,7 +230,7 @@ static uint32_t dl_chunk(struct co_pgm *pg, uint32_t offset, const uint8_t *data
 	if (offset < CO_PGM_HDR_SIZE) {
 		uint32_t n = MIN(end, CO_PGM_HDR_SIZE) - offset;
 
-		memcpy(&pg->hdr[offset], data, n);
+		(void)memcpy(&pg->hdr[offset], data, n);
 		if (end >= CO_PGM_HDR_SIZE) {
 			err = co_pgm_image_parse(pg->hdr, &pg->dl);
 			if (err != 0) {
@@ -298,6 +298,8 @@ static uint32_t dl_write(struct co_pgm *pg, uint32_t offset, const void *data, s
 		}
 	} else if (pg->dl_slot < 0) {
 		return CO_SDO_AB_HW;
+	} else {
+		/* The next chunk of the download under way. */
 	}
 	if (len > 0U) {
 		ab = dl_chunk(pg, offset, data, len);
@@ -490,7 +492,7 @@ static uint32_t prov_read(const struct co_od_provider *p, const struct co_od_inf
 		return 0;
 	}
 	*len = MIN(cap, info->size - offset);
-	memcpy(buf, tmp + offset, *len);
+	(void)memcpy(buf, tmp + offset, *len);
 	return 0;
 }
 
@@ -521,7 +523,7 @@ static int pgm_init(struct co_node *node)
 {
 	struct co_pgm *pg = &node->pgm;
 
-	memset(pg, 0, sizeof(*pg));
+	(void)memset(pg, 0, sizeof(*pg));
 	pg->node = node;
 	pg->run_slot = -1;
 	pg->pend_slot = -1;

@@ -49,7 +49,7 @@ static int file_erase(struct co_pgm_flash *f, uint8_t slot)
 		/* The power goes half way through the erase. */
 		end = f->slot_size / 2U;
 	}
-	memset(ones, 0xff, sizeof(ones));
+	(void)memset(ones, 0xff, sizeof(ones));
 	for (uint32_t off = 0; off < end && err == 0; off += CHUNK) {
 		err = co_host_file_pwrite(ff->fd, slot_base(f, slot) + off, ones,
 					  MIN(CHUNK, end - off));
@@ -161,7 +161,7 @@ int co_pgm_flash_file_open(struct co_pgm_flash_file *ff, const char *path, uint3
 		co_host_file_close(fd);
 		return size < 0 ? (int)size : -EFBIG;
 	}
-	memset(ff, 0, sizeof(*ff));
+	(void)memset(ff, 0, sizeof(*ff));
 	ff->flash.api = &file_api;
 	ff->flash.slot_size = slot_size;
 	ff->fd = fd;

@@ -37,11 +37,11 @@ static int ram_erase(struct co_pgm_flash *f, uint8_t slot)
 	}
 	if (r->budget == 0) {
 		/* The power goes half way through the erase. */
-		memset(slot_mem(r, slot), 0xff, f->slot_size / 2U);
+		(void)memset(slot_mem(r, slot), 0xff, f->slot_size / 2U);
 		r->off = true;
 		return -EIO;
 	}
-	memset(slot_mem(r, slot), 0xff, f->slot_size);
+	(void)memset(slot_mem(r, slot), 0xff, f->slot_size);
 	r->erases++;
 	return 0;
 }
@@ -94,7 +94,7 @@ static int ram_read(struct co_pgm_flash *f, uint8_t slot, uint32_t off, void *bu
 	if (slot > 1U || (uint64_t)off + len > f->slot_size) {
 		return -EINVAL;
 	}
-	memcpy(buf, slot_mem(r, slot) + off, len);
+	(void)memcpy(buf, slot_mem(r, slot) + off, len);
 	return 0;
 }
 
@@ -109,12 +109,12 @@ int co_pgm_flash_ram_init(struct co_pgm_flash_ram *r, void *mem, uint32_t slot_s
 	if (r == NULL || mem == NULL || slot_size < 16U + CO_PGM_HDR_SIZE) {
 		return -EINVAL;
 	}
-	memset(r, 0, sizeof(*r));
+	(void)memset(r, 0, sizeof(*r));
 	r->flash.api = &ram_api;
 	r->flash.slot_size = slot_size;
 	r->mem = mem;
 	r->budget = -1;
-	memset(mem, 0xff, (size_t)slot_size * 2U);
+	(void)memset(mem, 0xff, (size_t)slot_size * 2U);
 	return 0;
 }
 

@@ -47,7 +47,7 @@ static uint32_t get_u32(const uint8_t *p)
 void co_pgm_image_header(uint8_t hdr[CO_PGM_HDR_SIZE], const void *body, uint32_t len,
 			 uint32_t date, uint32_t time)
 {
-	memset(hdr, 0, CO_PGM_HDR_SIZE);
+	(void)memset(hdr, 0, CO_PGM_HDR_SIZE);
 	put_u32(&hdr[0], CO_PGM_MAGIC);
 	hdr[4] = (uint8_t)CO_PGM_HDR_VERSION;
 	hdr[6] = (uint8_t)CO_PGM_HDR_SIZE;
