@@ -65,7 +65,28 @@ def test_a_counted_run_fuzzes_that_many_inputs_with_the_seed():
     r = fuzz("nmt", "--runs", "300", "--seed", "1", "--no-save")
     assert r.returncode == 0, r.stdout + r.stderr
     assert "300 inputs each, seed 1" in r.stdout.splitlines()[0]
-    assert re.search(r"^nmt +ok +300 executions$", r.stdout, re.M), r.stdout
+    assert re.search(r"^nmt +ok +300 executions from \d+ inputs$", r.stdout, re.M), r.stdout
+
+
+@needs_clang
+def test_a_counted_run_starts_from_the_committed_seeds_only():
+    seeds = len(os.listdir(os.path.join(BASE, "tests", "fuzz", "nmt", "corpus")))
+    found = os.path.join(BASE, "build", "fuzz", "corpus", "nmt")
+    os.makedirs(found, exist_ok=True)
+    extra = os.path.join(found, "test-counted-run-ignores-me")
+    with open(extra, "wb") as f:
+        f.write(b"\x01\x02\x03 an input an earlier timed run found")
+    try:
+        counted = fuzz("nmt", "--runs", "300", "--seed", "1", "--no-save")
+        timed = fuzz("nmt", "--time", "1", "--no-save")
+    finally:
+        os.remove(extra)
+    assert counted.returncode == 0, counted.stdout + counted.stderr
+    assert re.search(rf"^nmt +ok +300 executions from {seeds} inputs$", counted.stdout,
+                     re.M), counted.stdout
+    # A timed run reads the earlier finds too: at least the extra file more.
+    m = re.search(r"^nmt +ok +\d+ executions from (\d+) inputs$", timed.stdout, re.M)
+    assert m and int(m.group(1)) > seeds, timed.stdout
 
 
 @needs_clang
