@@ -40,8 +40,12 @@ BUILD_ASSERT(CONFIG_CANOPEN_SDO_CLIENTS >= CONFIG_CANOPEN_MGR_SLAVES,
  */
 #define CFG_WAIT_POLL_MS 100U
 
-/* A step that waits for the slave's default SDO (held by an SRD) looks again after [ms]. */
-#define SDO_WAIT_POLL_MS 10U
+/*
+ * A step that waits for the slave's default SDO (held by an SRD) looks again after [ms]. The
+ * SDO manager wakes it whenever it may have given one back (co_mgr_boot_sdo_recheck()): the
+ * poll is the fallback.
+ */
+#define SDO_WAIT_POLL_MS 100U
 
 /* "load" (CiA 301 1011h) on the wire. */
 static const uint8_t sig_load[4] = {'l', 'o', 'a', 'd'};
@@ -948,6 +952,18 @@ void co_mgr_boot_resume(struct co_mgr_slave *s)
 		s->held = false;
 		/* From the line thread, after the SDO client confirmed the cut transfer. */
 		co_node_timer_start(s->mgr->node, &s->timer, co_mgr_now(s->mgr));
+	}
+}
+
+void co_mgr_boot_sdo_recheck(struct co_mgr *m)
+{
+	for (int i = 0; i < CONFIG_CANOPEN_MGR_SLAVES; i++) {
+		struct co_mgr_slave *s = &m->slaves[i];
+
+		if (s->id != 0U && s->booting && s->sdo_wait) {
+			/* From the slave's timer, once the SDO manager's own call has returned. */
+			co_node_timer_start(m->node, &s->timer, co_mgr_now(m));
+		}
 	}
 }
 

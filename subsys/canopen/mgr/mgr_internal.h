@@ -176,6 +176,8 @@ void co_mgr_boot_abort_sdo(struct co_mgr_slave *s, uint32_t abort_code);
 void co_mgr_boot_stopped(struct co_mgr_slave *s);
 /* The master runs again: start the held attempt (from the line thread). */
 void co_mgr_boot_resume(struct co_mgr_slave *s);
+/* The SDO manager may have given a default SDO back: boots that wait for one look again now. */
+void co_mgr_boot_sdo_recheck(struct co_mgr *m);
 /* Boot step timeouts, retries and the wait for a boot-up after the error handler. */
 void co_mgr_slave_timer_handler(struct co_timer *timer, uint64_t now_us);
 

@@ -677,6 +677,10 @@ static void con(struct co_sdo_cli *c, uint32_t ab, size_t size, void *user_data)
 
 	ARG_UNUSED(c);
 	d->busy_node = 0U;
+	/* This transfer, and what it ends (a release, a de-registration), may free a default
+	 * SDO: a waiting boot looks once this call has returned, not at its next poll.
+	 */
+	co_mgr_boot_sdo_recheck(m);
 	switch (d->op) {
 	case OP_SCAN:
 		/* 302 §7.2.1: the first SRD with Rq indication set ends the scan. */
@@ -1046,6 +1050,8 @@ static void work_handler(struct co_timer *timer, uint64_t now_us)
 	uint32_t ab = m->sdom.fake_ab;
 
 	ARG_UNUSED(now_us);
+	/* A loss handled here (next()) may free a default SDO too. */
+	co_mgr_boot_sdo_recheck(m);
 	if (ab != 0U) {
 		m->sdom.fake_ab = 0U;
 		con(cli(m), ab, 0U, m);

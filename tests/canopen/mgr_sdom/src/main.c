@@ -901,6 +901,23 @@ static int count_rtr(uint8_t id, uint64_t since)
 	return n;
 }
 
+/*
+ * Time from the frame before the first SDO upload of @p index on CAN-ID @p id since @p since
+ * to that upload (the wake-up of a step that waited), or -1 without such an upload.
+ */
+static int64_t gap_before_upload(uint32_t id, uint16_t index, uint64_t since)
+{
+	for (int i = 1; i < bus.n_log; i++) {
+		const struct can_frame *f = &bus.log[i].f;
+
+		if (bus.log[i].at >= since && f->id == id && (f->data[0] & 0xE0U) == 0x40U &&
+		    sys_get_le16(&f->data[1]) == index) {
+			return (int64_t)(bus.log[i].at - bus.log[i - 1].at);
+		}
+	}
+	return -1;
+}
+
 /* Whether the NMT master sent "start" (000#01nn) to @p id since @p since. */
 static bool seen_start(uint8_t id, uint64_t since)
 {
@@ -937,6 +954,7 @@ static int count_uploads(uint32_t id, uint16_t index, uint64_t since)
  */
 ZTEST(co_mgr_sdom, test_boot_waits_for_srd_default_connection)
 {
+	int64_t gap;
 	uint64_t t0;
 
 	cfg(MGR, 0x1F81, ID_SLV, 0x05U, 4);
@@ -961,6 +979,10 @@ ZTEST(co_mgr_sdom, test_boot_waits_for_srd_default_connection)
 	zassert_equal(conn(2), 0U, "released");
 	zassert_equal(conn(3), 0U, "released");
 	zassert_true(count_uploads(0x600U + ID_SLV, 0x1000, t0) > 0, "the boot goes on");
+	/* Woken by the release's end, not by its 100 ms poll. */
+	gap = gap_before_upload(0x600U + ID_SLV, 0x1000, t0);
+	zassert_true(gap >= 0 && gap < 1000, "the boot's first request %lld us after the release",
+		     (long long)gap);
 	zassert_true(seen_start(ID_SLV, t0), "and ends: NMT start");
 }
 
