@@ -218,9 +218,16 @@ enum co_line_msg_kind {
 
 struct co_line_rx_msg {
 	struct can_frame frame;
-	uint64_t time_us;
+	/*
+	 * Low 32 bits of the reception time [µs]: a message waits far less than the 35 minutes
+	 * that half of them span, and the reader extends them from its own time. With a 64-bit
+	 * time the message would be 8-aligned: 32 instead of 24 bytes (28 on a shared line).
+	 */
+	uint32_t time_lo;
+#if defined(CONFIG_CANOPEN_LINE_SHARED)
 	/* CO_LINE_MSG_LOCAL: lock of the sending node, whose receivers skip the frame. */
 	const struct k_mutex *origin;
+#endif
 	uint8_t kind;
 };
 

@@ -1167,7 +1167,7 @@ local_deliver(struct co_line *line, const struct can_frame *frame, const struct 
 {
 	struct co_line_rx_msg msg = {
 		.frame = *frame,
-		.time_us = co_line_time(line),
+		.time_lo = (uint32_t)co_line_time(line),
 		.origin = origin,
 		.kind = CO_LINE_MSG_LOCAL,
 	};
@@ -1199,6 +1199,7 @@ int co_line_send_from(struct co_line *line, const struct can_frame *frame,
 
 void co_line_local_drain(struct co_line *line)
 {
+#if defined(CONFIG_CANOPEN_LINE_SHARED)
 	struct co_line_rx_msg msg;
 
 	/* Bounded: handlers may send (and so queue) more local frames. */
@@ -1207,9 +1208,13 @@ void co_line_local_drain(struct co_line *line)
 			break;
 		}
 		if (msg.kind == CO_LINE_MSG_LOCAL) {
-			co_line_dispatch(line, &msg.frame, msg.time_us, msg.origin);
+			co_line_dispatch(line, &msg.frame,
+					 co_line_msg_time(&msg, co_line_time(line)), msg.origin);
 		}
 	}
+#else
+	ARG_UNUSED(line);
+#endif
 }
 
 void co_line_tx_drain(struct co_line *line)

@@ -35,6 +35,15 @@ static inline bool co_line_is_sim(const struct co_line *line)
 	return IS_ENABLED(CONFIG_CANOPEN_LINE_SIM) && line->dev == NULL;
 }
 
+/*
+ * The reception time of a queued message: its low 32 bits extended from @p ref, a time of the
+ * same line within 2^31 µs of it (the reader's current time).
+ */
+static inline uint64_t co_line_msg_time(const struct co_line_rx_msg *msg, uint64_t ref)
+{
+	return ref + (uint64_t)(int64_t)(int32_t)(msg->time_lo - (uint32_t)ref);
+}
+
 /* Wake the line thread so it re-reads its deadline (no-op in simulation). */
 void co_line_wake(struct co_line *line);
 

@@ -92,7 +92,7 @@ static void line_rx_cb(const struct device *dev, struct can_frame *frame, void *
 	struct co_line *line = user_data;
 	struct co_line_rx_msg msg = {
 		.frame = *frame,
-		.time_us = line_rx_time(frame),
+		.time_lo = (uint32_t)line_rx_time(frame),
 		.kind = CO_LINE_MSG_FRAME,
 	};
 
@@ -183,13 +183,17 @@ static void line_report_async(struct co_line *line)
 static void line_drain(struct co_line *line, struct co_line_rx_msg *msg)
 {
 	int budget = CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE;
+	/* Read after the first message was taken: within 2^31 µs of every queued time. */
+	uint64_t ref = co_line_now();
 
 	do {
 		if (msg->kind == CO_LINE_MSG_FRAME) {
-			co_line_rx(line, &msg->frame, msg->time_us);
-		} else if (IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED) &&
-			   msg->kind == CO_LINE_MSG_LOCAL) {
-			co_line_dispatch(line, &msg->frame, msg->time_us, msg->origin);
+			co_line_rx(line, &msg->frame, co_line_msg_time(msg, ref));
+#if defined(CONFIG_CANOPEN_LINE_SHARED)
+		} else if (msg->kind == CO_LINE_MSG_LOCAL) {
+			co_line_dispatch(line, &msg->frame, co_line_msg_time(msg, ref),
+					 msg->origin);
+#endif
 		} else {
 			atomic_clear_bit(&line->flags, CO_LINE_F_WAKE_PENDING);
 		}

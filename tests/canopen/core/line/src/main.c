@@ -634,6 +634,43 @@ ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 	zassert_equal(st.rx_frames, 0, "local frames are not counted as received from the bus");
 }
 
+/*
+ * A queued message keeps the low 32 bits of its time: the reader extends them from its own
+ * time, on either side of a wrap of those bits, and for a message from after the reader's time.
+ */
+ZTEST(co_line, test_a_queued_frame_keeps_its_time_across_a_32_bit_wrap)
+{
+	const uint64_t wrap = 0x100000000ULL;
+	struct co_line_rx_msg m = {.time_lo = (uint32_t)(wrap - 3U)};
+
+	zassert_equal(co_line_msg_time(&m, wrap + 7U), wrap - 3U);
+	zassert_equal(co_line_msg_time(&m, wrap - 3U), wrap - 3U);
+	zassert_equal(co_line_msg_time(&m, wrap - 10U), wrap - 3U, "a time after the reader's");
+	m.time_lo = 2U;
+	zassert_equal(co_line_msg_time(&m, wrap - 10U), wrap + 2U);
+	zassert_equal(co_line_msg_time(&m, 5U * wrap + 1000000U), 5U * wrap + 2U);
+	zassert_equal(co_line_msg_time(&m, 3U), 2U);
+
+	/* Through the queue: a local frame sent just before the wrap, delivered after it. */
+	struct k_mutex node_a, node_b;
+	struct co_line_member ma, mb;
+	struct co_rx rb;
+	struct can_frame f = std_frame(0x702, 1);
+
+	k_mutex_init(&node_a);
+	k_mutex_init(&node_b);
+	rx_fill(&rb, 0x702, 0x7ff, false, 2);
+	rb.lock = &node_b;
+	zassert_ok(co_rx_register(&fx.line, &rb));
+	co_line_attach(&fx.line, &ma, &node_a);
+	co_line_attach(&fx.line, &mb, &node_b);
+	co_line_process(&fx.line, 5U * wrap - 1U);
+	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
+	co_line_process(&fx.line, 5U * wrap + 20U);
+	zassert_equal(fx.log_len, 1);
+	zassert_equal(fx.log_time[0], 5U * wrap - 1U, "reception time = send time");
+}
+
 /* --- Listeners ------------------------------------------------------------------------------ */
 
 struct listener_log {
