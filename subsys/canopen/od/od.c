@@ -583,7 +583,10 @@ static int hooks_remove(struct co_od *od, bool batch, uint32_t first_seq, const 
 	for (uint16_t r = 0; r < od->n_hooks; r++) {
 		if (batch ? (od->hook_seq[r] >= first_seq)
 			  : (od->hooks[r].user_data == user_data)) {
-			removed++;
+			/* A hook's read check is an entry of its own: count the hook once. */
+			if (od->hooks[r].kind == CO_OD_HOOK_ENT_PLAIN) {
+				removed++;
+			}
 			continue;
 		}
 		od->hooks[w] = od->hooks[r];
@@ -630,20 +633,39 @@ int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook)
 		return -EINVAL;
 	}
 	OD_ASSERT_LOCKED(od);
-	if (od->n_hooks >= CO_OD_HOOKS_MAX) {
+	uint16_t n = (hook->read_check != NULL) ? 2U : 1U;
+
+	if (od->n_hooks + n > CO_OD_HOOKS_MAX) {
 		return -ENOSPC;
 	}
 	/* Keep the table sorted by first index; equal keys keep registration order. */
 	uint16_t pos = od->n_hooks;
 
 	while (pos > 0U && od->hooks[pos - 1U].index_first > hook->index_first) {
-		od->hooks[pos] = od->hooks[pos - 1U];
-		od->hook_seq[pos] = od->hook_seq[pos - 1U];
+		od->hooks[pos + n - 1U] = od->hooks[pos - 1U];
+		od->hook_seq[pos + n - 1U] = od->hook_seq[pos - 1U];
 		pos--;
 	}
-	od->hooks[pos] = *hook;
-	od->hook_seq[pos] = od->hook_next_seq++;
-	od->n_hooks++;
+	struct co_od_hook_ent e = {
+		.index_first = hook->index_first,
+		.index_last = hook->index_last,
+		.sub_first = hook->sub_first,
+		.sub_last = hook->sub_last,
+		.kind = CO_OD_HOOK_ENT_PLAIN,
+		.fn.validate = hook->validate,
+		.notify = hook->notify,
+		.user_data = hook->user_data,
+	};
+
+	for (uint16_t k = 0U; k < n; k++) {
+		od->hooks[pos + k] = e;
+		od->hook_seq[pos + k] = od->hook_next_seq++;
+		/* The read check next: the same range, a later registration number. */
+		e.kind = CO_OD_HOOK_ENT_READ_CHECK;
+		e.fn.read_check = hook->read_check;
+		e.notify = NULL;
+	}
+	od->n_hooks += n;
 	hook_gen_bump(od);
 	uint16_t span = hook->index_last - hook->index_first;
 
@@ -678,7 +700,7 @@ static uint16_t hooks_start(const struct co_od *od, uint16_t index)
 	return lo;
 }
 
-static bool hook_covers(const struct co_od_hook *h, uint16_t index, uint8_t sub)
+static bool hook_covers(const struct co_od_hook_ent *h, uint16_t index, uint8_t sub)
 {
 	return index >= h->index_first && index <= h->index_last && sub >= h->sub_first &&
 	       sub <= h->sub_last;
@@ -727,17 +749,17 @@ static uint32_t run_validate_at(struct co_od *od, const struct co_od_req *req, u
 	uint32_t limit = od->hook_next_seq;
 
 	while (i < od->n_hooks && i < end && od->hooks[i].index_first <= index) {
-		const struct co_od_hook *h = &od->hooks[i];
+		const struct co_od_hook_ent *h = &od->hooks[i];
 
-		if (h->validate == NULL || od->hook_seq[i] >= limit ||
-		    !hook_covers(h, index, req->info->sub)) {
+		if (h->kind != CO_OD_HOOK_ENT_PLAIN || h->fn.validate == NULL ||
+		    od->hook_seq[i] >= limit || !hook_covers(h, index, req->info->sub)) {
 			i++;
 			continue;
 		}
 		struct co_od_req copy = *req;
 		uint16_t first = h->index_first;
 		uint32_t seq = od->hook_seq[i];
-		uint32_t r = h->validate(od, &copy, h->user_data);
+		uint32_t r = h->fn.validate(od, &copy, h->user_data);
 
 		if (r == CO_OD_HANDLED) {
 			result = CO_OD_HANDLED;
@@ -768,7 +790,7 @@ static void notify_from(struct co_od *od, const struct co_od_req *req, uint16_t 
 	uint32_t gen = od->hook_gen;
 
 	while (i < od->n_hooks && i < end && od->hooks[i].index_first <= index) {
-		const struct co_od_hook *h = &od->hooks[i];
+		const struct co_od_hook_ent *h = &od->hooks[i];
 
 		if (h->notify == NULL || od->hook_seq[i] >= limit ||
 		    !hook_covers(h, index, req->info->sub)) {
@@ -991,12 +1013,12 @@ static uint32_t run_read_check_at(const struct co_od *od, const struct co_od_inf
 		return 0U;
 	}
 	for (; i < od->n_hooks && i < end && od->hooks[i].index_first <= index; i++) {
-		const struct co_od_hook *h = &od->hooks[i];
+		const struct co_od_hook_ent *h = &od->hooks[i];
 
-		if (h->read_check == NULL || !hook_covers(h, index, info->sub)) {
+		if (h->kind != CO_OD_HOOK_ENT_READ_CHECK || !hook_covers(h, index, info->sub)) {
 			continue;
 		}
-		uint32_t r = h->read_check(od, info, reader, h->user_data);
+		uint32_t r = h->fn.read_check(od, info, reader, h->user_data);
 
 		if (r != 0U) {
 			return r;
@@ -1260,7 +1282,7 @@ cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_c
 	cover->end = 0U;
 	for (uint16_t i = hooks_start(od, index);
 	     i < od->n_hooks && od->hooks[i].index_first <= index; i++) {
-		const struct co_od_hook *h = &od->hooks[i];
+		const struct co_od_hook_ent *h = &od->hooks[i];
 
 		if (!hook_covers(h, index, info->sub)) {
 			/* A hook between two covering ones: the range is not exact. */
@@ -1275,9 +1297,12 @@ cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_c
 			flags &= (uint16_t)~CO_OD_COVER_EXACT;
 		}
 		cover->end = i + 1U;
-		flags |= (h->validate != NULL ? CO_OD_COVER_VALIDATE : 0U) |
-			 (h->notify != NULL ? CO_OD_COVER_NOTIFY : 0U) |
-			 (h->read_check != NULL ? CO_OD_COVER_READ_CHECK : 0U);
+		if (h->kind == CO_OD_HOOK_ENT_READ_CHECK) {
+			flags |= CO_OD_COVER_READ_CHECK;
+		} else {
+			flags |= (h->fn.validate != NULL ? CO_OD_COVER_VALIDATE : 0U) |
+				 (h->notify != NULL ? CO_OD_COVER_NOTIFY : 0U);
+		}
 	}
 	if (INFO_PROV(info) == NULL && (info->flags & CO_OD_F_ROM) == 0U &&
 	    co_dtype_size(info->dtype) != 0U && info->size == co_dtype_size(info->dtype) &&
@@ -1342,7 +1367,7 @@ static OD_HOT_INLINE void run_notify_cover(struct co_od *od, const struct co_od_
 	uint16_t i = cover->first;
 
 	do {
-		const struct co_od_hook *h = &od->hooks[i];
+		const struct co_od_hook_ent *h = &od->hooks[i];
 
 		if (h->notify != NULL) {
 			uint16_t first = h->index_first;
@@ -1465,7 +1490,7 @@ uint32_t co_od_write_cover(struct co_od *od, const struct co_od_info *info,
 		 */
 		const struct co_od_req req = {
 			.info = info, .writer = writer, .data = data, .len = len};
-		const struct co_od_hook *h = &od->hooks[cover->first];
+		const struct co_od_hook_ent *h = &od->hooks[cover->first];
 
 		h->notify(od, &req, h->user_data);
 		return 0U;

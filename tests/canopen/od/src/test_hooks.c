@@ -211,6 +211,72 @@ ZTEST(od_hooks, test_registration_limits_and_unregister)
 	zassert_equal(r.notifies, 0);
 }
 
+static int rc_calls;
+
+static uint32_t rc_refuse(const struct co_od *od, const struct co_od_info *info,
+			  enum co_od_writer reader, void *user_data)
+{
+	rc_calls++;
+	return CO_SDO_AB_NO_DATA;
+}
+
+/*
+ * A hook's read check takes a table entry of its own, after its validate and notify entry:
+ * such a hook needs two free entries, counts as one hook when removed, and keeps its place in
+ * the order of the validate and notify hooks.
+ */
+ZTEST(od_hooks, test_a_hook_with_a_read_check_takes_two_entries)
+{
+	struct rec log = {0};
+	struct rec a = {.id = 1, .log = &log};
+	struct rec b = {.id = 2, .log = &log};
+	struct rec c = {.id = 3, .log = &log};
+	struct rec fill = {0};
+	struct rec rc = {0};
+	const struct co_od_hook with_check = {
+		.index_first = 0x1017,
+		.index_last = 0x1017,
+		.validate = v_hook,
+		.notify = n_hook,
+		.user_data = &b,
+		.read_check = rc_refuse,
+	};
+	uint8_t buf[2];
+	size_t len;
+
+	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &a));
+	for (int i = 1; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 1; i++) {
+		zassert_ok(hook(&fx.od, 0x2000 + i, 0x2000 + i, 0, 0, &fill));
+	}
+	zassert_equal(co_od_hook_register(&fx.od, &with_check), -ENOSPC, "one entry is free");
+	zassert_equal(co_od_hook_unregister(&fx.od, &fill), CONFIG_CANOPEN_OD_HOOKS_MAX - 2);
+	for (int i = 1; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 3; i++) {
+		zassert_ok(hook(&fx.od, 0x2000 + i, 0x2000 + i, 0, 0, &fill));
+	}
+	/* Three entries free: the hook with its check, then one more. */
+	rc_calls = 0;
+	zassert_ok(co_od_hook_register(&fx.od, &with_check));
+	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &c));
+	zassert_equal(hook(&fx.od, 0x1017, 0x1017, 0, 0, &rc), -ENOSPC, "the table is full");
+
+	zassert_equal(co_od_read(&fx.od, 0x1017, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_SDO),
+		      CO_SDO_AB_NO_DATA, "the read check runs");
+	zassert_equal(rc_calls, 1);
+	zassert_ok(co_od_read(&fx.od, 0x1017, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_APP));
+	zassert_ok(co_od_set_u16(&fx.od, 0x1017, 0, 5, CO_OD_WRITER_SDO));
+	zassert_equal(log.n_order, 6);
+	static const int expected[] = {1, 2, 3, 11, 12, 13};
+
+	zassert_mem_equal(log.order, expected, sizeof(expected), "registration order");
+
+	zassert_equal(co_od_hook_unregister(&fx.od, &b), 1, "one hook, two entries");
+	zassert_ok(co_od_read(&fx.od, 0x1017, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_SDO));
+	zassert_equal(rc_calls, 1, "a removed read check does not run");
+	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &rc));
+	zassert_ok(hook(&fx.od, 0x1018, 0x1018, 0, 0, &rc), "both entries were freed");
+	zassert_equal(hook(&fx.od, 0x1018, 0x1018, 0, 0, &rc), -ENOSPC);
+}
+
 ZTEST(od_hooks, test_hooks_are_per_node)
 {
 	struct rec r = {0};
