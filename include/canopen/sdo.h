@@ -101,25 +101,24 @@ struct co_sdo_srv_stats {
 struct co_sdo_srv {
 	struct co_node *node;
 	struct co_rx rx;
-	/* The line of the last request: answers go there. */
-	uint8_t route;
+	/* COB-IDs in use (sub-index 1 and 2 as last configured). */
+	uint32_t cob_rx;
 	struct co_timer timer;
-	/* Chunked write into the dictionary (segmented and block download). */
+	/*
+	 * Chunked write into the dictionary (segmented and block download). An upload keeps
+	 * its object in xfer.info: the two never run at once, and xfer.active stays false.
+	 */
 	struct co_od_xfer xfer;
-	/* The object being uploaded. */
-	struct co_od_info info;
 	struct co_sdo_srv_stats stats;
+	uint32_t cob_tx;
 	/* Protocol timeout: last client frame + CONFIG_CANOPEN_SDO_SERVER_TIMEOUT. */
 	uint64_t deadline;
-	/* Timeouts put off because our own frames had not left the line yet. */
-	uint8_t tx_waits;
+#if defined(CONFIG_CANOPEN_SDO_BLOCK)
 	/* Block download sub-block timeout (0 = not armed). */
 	uint64_t sub_deadline;
 	/* Retry of a sub-block the TX queue could not take (0 = none pending). */
 	uint64_t retry_at;
-	/* COB-IDs in use (sub-index 1 and 2 as last configured). */
-	uint32_t cob_rx;
-	uint32_t cob_tx;
+#endif
 	/* Size of the value: announced (download, if size_ind) or current (upload). */
 	uint32_t size;
 	/* Download: data bytes received (in order, excluding a held-back last segment).
@@ -133,11 +132,22 @@ struct co_sdo_srv {
 	/* Bytes valid in buf. */
 	uint32_t buf_len;
 	uint16_t index;
-	uint16_t crc;
 	uint8_t sub;
 	uint8_t num;
 	uint8_t state;
 	uint8_t toggle;
+	/* The line of the last request: answers go there. */
+	uint8_t route;
+	/* Timeouts put off because our own frames had not left the line yet. */
+	uint8_t tx_waits;
+	bool size_ind;
+	/* NMT state is Pre-operational or Operational. */
+	bool active;
+	/* Inside the receive handler; a COB-ID change is applied when it returns. */
+	bool in_rx;
+	bool reconf;
+#if defined(CONFIG_CANOPEN_SDO_BLOCK)
+	uint16_t crc;
 	/* Block size of the current sub-block. */
 	uint8_t blksize;
 	/* Block download: last in-order sequence number of the sub-block.
@@ -146,19 +156,14 @@ struct co_sdo_srv {
 	uint8_t seq;
 	/* Block upload: segments in the current sub-block. */
 	uint8_t blk_nseg;
-	bool size_ind;
 	bool crc_on;
 	/* Block download: a segment arrived in this sub-block. Block upload: the current
 	 * sub-block holds the last segment.
 	 */
 	bool blk_flag;
-	/* NMT state is Pre-operational or Operational. */
-	bool active;
-	/* Inside the receive handler; a COB-ID change is applied when it returns. */
-	bool in_rx;
-	bool reconf;
 	/* Block download: the last segment, held until the end frame tells its length. */
 	uint8_t tail[7];
+#endif
 	uint8_t buf[CO_SDO_SRV_BUF_SIZE] __attribute__((aligned(4)));
 };
 /** @endcond */

@@ -330,7 +330,7 @@ static uint32_t up_fill(struct co_sdo_srv *srv, uint32_t off, uint32_t need, boo
 	srv->buf_len = 0U;
 	do {
 		size_t got = 0U;
-		uint32_t code = co_od_read_info(srv_od(srv), &srv->info, off + srv->buf_len,
+		uint32_t code = co_od_read_info(srv_od(srv), &srv->xfer.info, off + srv->buf_len,
 						&srv->buf[srv->buf_len], want - srv->buf_len, &got,
 						CO_OD_WRITER_SDO);
 
@@ -355,12 +355,12 @@ static uint32_t up_fill(struct co_sdo_srv *srv, uint32_t off, uint32_t need, boo
 /* Look the object up, take its size and read the first window (access check). */
 static uint32_t up_open(struct co_sdo_srv *srv)
 {
-	uint32_t code = co_od_find(srv_od(srv), srv->index, srv->sub, &srv->info);
+	uint32_t code = co_od_find(srv_od(srv), srv->index, srv->sub, &srv->xfer.info);
 
 	if (code != CO_SDO_AB_NONE) {
 		return code;
 	}
-	srv->size = co_od_length(srv_od(srv), &srv->info);
+	srv->size = co_od_length(srv_od(srv), &srv->xfer.info);
 	srv->buf_off = 0U;
 	srv->buf_len = 0U;
 	return up_fill(srv, 0U, srv->size, true);

@@ -226,3 +226,31 @@ ZTEST(sdo_segmented, test_abort_06090031_value_checked_at_the_end)
 	zassert_equal(cli_dl_seg(0x2000, 0, v, 4, true), CO_SDO_AB_VALUE_HIGH);
 	zassert_equal(h.ram.manuf.x2000_limited_u32, 0x100);
 }
+
+/*
+ * An upload keeps its object where a download keeps its chunked write (one transfer state per
+ * server): a download the client aborted halfway leaves nothing behind for the upload that
+ * follows, nor for the next download of the same object.
+ */
+ZTEST(sdo_segmented, test_upload_and_download_after_an_aborted_download)
+{
+	static const char name[] = "SafeLine SDO test device";
+	uint8_t v[12];
+	uint8_t back[24];
+	uint32_t n;
+
+	h_fill(v, sizeof(v), 5);
+	h_req(0x21, 0x2004, 0, 12);
+	h_expect(0x60, 0x2004, 0, 0);
+	h_req(0x00, 0, 0, 0);
+	h_expect(0x20, 0, 0, 0);
+	h_req(0x80, 0x2004, 0, CO_SDO_AB_GENERAL);
+	h_expect_none();
+	zassert_ok(cli_ul(0x1008, 0, back, sizeof(back), &n));
+	zassert_equal(n, 24);
+	zassert_mem_equal(back, name, 24);
+	zassert_ok(cli_dl_seg(0x2004, 0, v, sizeof(v), true));
+	zassert_ok(cli_ul(0x2004, 0, back, sizeof(back), &n));
+	zassert_equal(n, 12);
+	zassert_mem_equal(back, v, 12);
+}
