@@ -83,7 +83,9 @@ struct co_hb_entry {
 	struct co_timer timer;
 	struct co_node *node;
 	uint16_t time_ms;
-	uint8_t remote_id;
+	/* The producer's node-ID is rx.id - 700h (0 while the entry is unused): a byte of its
+	 * own would make the entry 88 instead of 80 bytes on a 32-bit target.
+	 */
 	uint8_t state;
 	/* 0 unused/idle (waiting for a first heartbeat), 1 active, 2 lost */
 	uint8_t mon;

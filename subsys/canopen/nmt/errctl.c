@@ -141,16 +141,22 @@ static void hb_producer_notify(struct co_od *od, const struct co_od_req *req, vo
 
 /* --- Heartbeat consumer ------------------------------------------------------------------- */
 
+/* The producer's node-ID (0: the entry is unused). */
+static uint8_t hbc_remote(const struct co_hb_entry *e)
+{
+	return (uint8_t)(e->rx.id - CO_NMT_EC_COB_ID);
+}
+
 static void hbc_report(struct co_hb_entry *e, enum co_hb_event ev)
 {
 	struct co_node *node = e->node;
 	struct co_event event = {
 		.type = CO_EV_HB,
-		.hb = {.node_id = e->remote_id, .event = ev, .state = (enum co_nmt_state)e->state},
+		.hb = {.node_id = hbc_remote(e), .event = ev, .state = (enum co_nmt_state)e->state},
 	};
 
 	if (node->ec.hb_ind != NULL) {
-		node->ec.hb_ind(node, e->remote_id, ev, (enum co_nmt_state)e->state,
+		node->ec.hb_ind(node, hbc_remote(e), ev, (enum co_nmt_state)e->state,
 				node->ec.hb_user_data);
 	}
 	(void)co_node_publish(node, &event, NULL);
@@ -162,9 +168,9 @@ static void hbc_timeout(struct co_timer *timer, uint64_t now_us)
 
 	if (e->mon == HB_ACTIVE) {
 		e->mon = HB_LOST;
-		LOG_WRN("%s: heartbeat of node %u lost", e->node->name, e->remote_id);
+		LOG_WRN("%s: heartbeat of node %u lost", e->node->name, hbc_remote(e));
 		hbc_report(e, CO_HB_EV_LOST);
-		comm_error(e->node, e->remote_id, true);
+		comm_error(e->node, hbc_remote(e), true);
 	}
 }
 
@@ -188,7 +194,7 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		e->mon = HB_IDLE;
 		hbc_report(e, CO_HB_EV_BOOTUP);
 		if (was_lost) {
-			comm_error(e->node, e->remote_id, false);
+			comm_error(e->node, hbc_remote(e), false);
 		}
 		return;
 	}
@@ -199,7 +205,7 @@ static void hbc_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 	} else if (e->mon == HB_LOST) {
 		e->mon = HB_ACTIVE;
 		hbc_report(e, CO_HB_EV_RECOVERED);
-		comm_error(e->node, e->remote_id, false);
+		comm_error(e->node, hbc_remote(e), false);
 	} else if (prev != state) {
 		hbc_report(e, CO_HB_EV_STATE);
 	} else {
@@ -224,19 +230,18 @@ static void hbc_configure(struct co_node *node, int i, uint32_t value)
 	co_timer_stop(&e->timer);
 	e->mon = HB_IDLE;
 	if (was_lost) {
-		comm_error(node, e->remote_id, false);
+		comm_error(node, hbc_remote(e), false);
 	}
 	e->state = (uint8_t)CO_NMT_INITIALISING;
-	e->remote_id = 0U;
+	e->rx.id = CO_NMT_EC_COB_ID;
 	e->time_ms = 0U;
 	if (!hbc_value_active(value)) {
 		return;
 	}
-	e->remote_id = (uint8_t)(value >> 16);
 	e->time_ms = (uint16_t)value;
-	e->rx.id = CO_NMT_EC_COB_ID + e->remote_id;
+	e->rx.id = CO_NMT_EC_COB_ID + ((value >> 16) & 0x7fU);
 	if (co_node_rx_register(node, CO_LINE_DEFAULT, &e->rx) != 0) {
-		LOG_ERR("%s: no receive slot to monitor node %u", node->name, e->remote_id);
+		LOG_ERR("%s: no receive slot to monitor node %u", node->name, hbc_remote(e));
 	}
 }
 
@@ -378,7 +383,7 @@ static int errctl_init(struct co_node *node)
 		struct co_hb_entry *e = &ec->hbc[i];
 
 		e->node = node;
-		co_rx_init(&e->rx, 0U, hbc_rx, &node->lock, e);
+		co_rx_init(&e->rx, CO_NMT_EC_COB_ID, hbc_rx, &node->lock, e);
 		co_timer_init(&e->timer, hbc_timeout, &node->lock, e);
 	}
 #if defined(CONFIG_CANOPEN_NODE_GUARDING)
@@ -481,7 +486,7 @@ int co_hb_get_remote_state(struct co_node *node, uint8_t remote_id, enum co_nmt_
 	for (int i = 0; i < CONFIG_CANOPEN_HB_CONSUMERS; i++) {
 		struct co_hb_entry *e = &node->ec.hbc[i];
 
-		if (e->remote_id == remote_id && e->time_ms != 0U) {
+		if (hbc_remote(e) == remote_id && e->time_ms != 0U) {
 			if (e->mon == HB_IDLE) {
 				err = -EAGAIN;
 			} else {
