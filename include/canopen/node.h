@@ -29,6 +29,7 @@
 #ifndef SAFELINE_INCLUDE_CANOPEN_NODE_H_
 #define SAFELINE_INCLUDE_CANOPEN_NODE_H_
 
+#include <errno.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -57,8 +58,15 @@ enum co_node_line_id {
 	CO_LINE_REDUNDANT = 1,
 };
 
-/** Number of lines a node can be attached to. */
+/**
+ * Number of lines a node can be attached to: two with CONFIG_CANOPEN_NODE_REDUNDANT_LINE, else
+ * one (the default line; co_node_attach_line() returns -ENOTSUP).
+ */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 #define CO_NODE_LINES 2U
+#else
+#define CO_NODE_LINES 1U
+#endif
 
 /**
  * @name Routes: which of its lines a node sends a frame on
@@ -89,6 +97,11 @@ typedef uint8_t co_route_t;
 /** @} */
 
 /** @cond INTERNAL_HIDDEN */
+/* The routes that include the default line on a node that has no other. */
+#define CO_ROUTE_ON_DEFAULT (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE | CO_ROUTE_PROCESS | CO_ROUTE_EC)
+/** @endcond */
+
+/** @cond INTERNAL_HIDDEN */
 struct co_service;
 
 /* One of the node's lines, with what the node registered on it. */
@@ -107,6 +120,7 @@ struct co_node {
 	struct k_mutex lock;
 	const char *name;
 	struct co_node_line lines[CO_NODE_LINES];
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 	uint8_t active_line;
 	/* The line the frame being dispatched came on (co_node_rx_line()). */
 	uint8_t rx_line;
@@ -114,6 +128,7 @@ struct co_node {
 	co_route_t process_route;
 	/* Lines left out of CO_ROUTE_PROCESS (co_node_set_tx_excluded()). */
 	co_route_t tx_excluded;
+#endif
 	struct co_od od;
 	uint8_t node_id;
 	/* Node-ID to use from the next Reset Communication (LSS may change it). */
@@ -169,6 +184,9 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
  * too, through co_node_dispatch_from(). Without it they hear the default line only.
  *
  * @retval 0 Attached.
+ * @retval -ENOTSUP The node can have one line only (built without
+ *         CONFIG_CANOPEN_NODE_REDUNDANT_LINE, which CONFIG_CANOPEN_REDUNDANCY selects), whatever
+ *         the arguments.
  * @retval -EINVAL A NULL argument, or @p idx is not CO_LINE_REDUNDANT.
  * @retval -EALREADY A line is attached there already, or it is the default line.
  * @retval -EBUSY The node has been started.
@@ -247,7 +265,9 @@ int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx);
  */
 
 /** @cond INTERNAL_HIDDEN */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_send_routed(struct co_node *node, co_route_t route, const struct can_frame *frame);
+#endif
 #if defined(CONFIG_CANOPEN_LOCK_CHECK)
 void co_node_assert_locked(const struct co_node *node);
 #endif
@@ -256,7 +276,9 @@ void co_node_assert_locked(const struct co_node *node);
 /**
  * @brief Send a frame on every line of @p route the node is attached to.
  *
- * Inline for the common case of a node on one line (the PDO hot path).
+ * Inline for the common case of a node on one line (the PDO hot path); on a node that can
+ * have one line only (no CONFIG_CANOPEN_NODE_REDUNDANT_LINE) every route but
+ * CO_ROUTE_REDUNDANT is that line, and nothing else is left.
  *
  * @retval 0 Sent or queued on every line of the route.
  * @retval -ENODEV The node has no line on that route.
@@ -266,23 +288,38 @@ void co_node_assert_locked(const struct co_node *node);
 static inline int co_node_send(struct co_node *node, co_route_t route,
 			       const struct can_frame *frame)
 {
-	if (node->lines[CO_LINE_REDUNDANT].line == NULL &&
-	    (route & (CO_ROUTE_DEFAULT | CO_ROUTE_ACTIVE | CO_ROUTE_PROCESS | CO_ROUTE_EC)) != 0U) {
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-		co_node_assert_locked(node);
-#endif
-		return co_line_send_from(node->lines[CO_LINE_DEFAULT].line, frame, &node->lock);
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
+	if (node->lines[CO_LINE_REDUNDANT].line != NULL || (route & CO_ROUTE_ON_DEFAULT) == 0U) {
+		return co_node_send_routed(node, route, frame);
 	}
-	return co_node_send_routed(node, route, frame);
+#else
+	if ((route & CO_ROUTE_ON_DEFAULT) == 0U) {
+		return -ENODEV;
+	}
+#endif
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+	co_node_assert_locked(node);
+#endif
+	return co_line_send_from(node->lines[CO_LINE_DEFAULT].line, frame, &node->lock);
 }
 
 /**
  * @brief The route that answers a frame received by @p rx: the line it came on.
  *
  * Call from the receiver's handler. A frame of the redundant line handed over by
- * co_node_dispatch_from() is answered there.
+ * co_node_dispatch_from() is answered there. Always CO_ROUTE_DEFAULT on a node that can have
+ * one line only (inline then).
  */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx);
+#else
+static inline co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx)
+{
+	ARG_UNUSED(node);
+	ARG_UNUSED(rx);
+	return CO_ROUTE_DEFAULT;
+}
+#endif
 
 /**
  * @brief The line the frame being handled came on (enum co_node_line_id).
@@ -293,30 +330,45 @@ co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx);
  */
 static inline uint8_t co_node_rx_line(const struct co_node *node)
 {
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 	return node->rx_line;
+#else
+	ARG_UNUSED(node);
+	return (uint8_t)CO_LINE_DEFAULT;
+#endif
 }
 
-/** @brief The node's active line (enum co_node_line_id). */
+/** @brief The node's active line (enum co_node_line_id; always the default on a one-line node). */
 static inline uint8_t co_node_active_line(const struct co_node *node)
 {
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 	return node->active_line;
+#else
+	ARG_UNUSED(node);
+	return (uint8_t)CO_LINE_DEFAULT;
+#endif
 }
 
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 /**
  * @brief Hand a frame that came on line @p idx to the node's receivers of the default line.
  *
  * For the redundancy service: one catch-all receiver on the redundant line brings its frames
  * to the node's services, which then hear both lines through the receivers they registered on
  * the default line; co_node_rx_line() tells them where a frame came from. Requires the node's
- * mutex (a receiver's handler holds it).
+ * mutex (a receiver's handler holds it). Only on a node that can have two lines
+ * (CONFIG_CANOPEN_NODE_REDUNDANT_LINE).
  *
  * @return Number of receivers called.
  */
 int co_node_dispatch_from(struct co_node *node, enum co_node_line_id idx,
 			  const struct can_frame *frame, uint64_t now_us);
+#endif
 
 /**
  * @brief Choose what CO_ROUTE_PROCESS means (CO_ROUTE_BOTH, or CO_ROUTE_ACTIVE).
+ *
+ * On a node that can have one line only both mean the default line: nothing is kept.
  *
  * @retval 0 Done.
  * @retval -EINVAL Another route.
@@ -327,7 +379,7 @@ int co_node_set_process_route(struct co_node *node, co_route_t route);
  * @brief Leave lines out of CO_ROUTE_PROCESS (their controller cannot send, e.g. error
  * passive after a cut, or bus-off), so that process data do not pile up behind them and go
  * out stale later. CO_ROUTE_EC still reaches them. A route that would be left without any
- * line keeps all of its lines.
+ * line keeps all of its lines, so on a node that can have one line only this does nothing.
  *
  * @param node The node.
  * @param lines CO_ROUTE_DEFAULT and/or CO_ROUTE_REDUNDANT, or 0.

@@ -193,6 +193,21 @@ static const struct nmt_transition {
 	{.cs = CO_NMT_CS_RESET_COMMUNICATION, .reset = true, .to = CO_NMT_INITIALISING},
 };
 
+/*
+ * Withdraw what the node queued on every line it has. The default line is there as long as
+ * the node is initialised; only a second one can be missing.
+ */
+static inline __attribute__((always_inline)) void
+purge_lines(struct co_node *node, bool (*keep)(const struct can_frame *f, void *arg), void *arg)
+{
+	(void)co_line_tx_purge(node->lines[CO_LINE_DEFAULT].line, &node->lock, keep, arg);
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
+	if (node->lines[CO_LINE_REDUNDANT].line != NULL) {
+		(void)co_line_tx_purge(node->lines[CO_LINE_REDUNDANT].line, &node->lock, keep, arg);
+	}
+#endif
+}
+
 /* In Stopped a node sends NMT error control only (CiA 301 §7.3.2.2); NMT commands of a master. */
 static bool stopped_may_send(const struct can_frame *f, void *arg)
 {
@@ -211,12 +226,7 @@ static void nmt_enter(struct co_node *node, enum co_nmt_state to)
 	node->nmt.state = to;
 	if (to == CO_NMT_STOPPED) {
 		/* Frames queued before (an SDO answer held up by back-pressure) stay unsent. */
-		for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
-			if (node->lines[i].line != NULL) {
-				(void)co_line_tx_purge(node->lines[i].line, &node->lock,
-						       stopped_may_send, node);
-			}
-		}
+		purge_lines(node, stopped_may_send, node);
 	}
 	LOG_INF("%s: %s -> %s", node->name, co_nmt_state_str(from), co_nmt_state_str(to));
 	services_set_state(node, from, to);
@@ -285,11 +295,7 @@ static void nmt_reset(struct co_node *node, enum co_nmt_cs cs)
 	/* What the node queued before (held by back-pressure or a stopped controller) belongs
 	 * to the communication being reset, maybe to its old node-ID: it stays unsent.
 	 */
-	for (unsigned int i = 0; i < CO_NODE_LINES; i++) {
-		if (node->lines[i].line != NULL) {
-			(void)co_line_tx_purge(node->lines[i].line, &node->lock, NULL, NULL);
-		}
-	}
+	purge_lines(node, NULL, NULL);
 	if (cs == CO_NMT_CS_RESET_NODE) {
 		co_od_reset_app(&node->od);
 	}
@@ -426,9 +432,13 @@ static void line_event(struct co_line_listener *l, enum co_line_event event, int
 	struct co_node *node = l->user_data;
 	struct co_event ev = {
 		.type = CO_EV_LINE,
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 		.line = {.idx = (uint8_t)(l == &node->lines[CO_LINE_REDUNDANT].listener
 						  ? CO_LINE_REDUNDANT
 						  : CO_LINE_DEFAULT),
+#else
+		.line = {.idx = (uint8_t)CO_LINE_DEFAULT,
+#endif
 			 .event = event,
 			 .arg = arg},
 	};
@@ -466,6 +476,7 @@ static void line_leave(struct co_node *node, enum co_node_line_id idx)
 	}
 }
 
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_attach_line(struct co_node *node, enum co_node_line_id idx, struct co_line *line)
 {
 	int err;
@@ -484,6 +495,15 @@ int co_node_attach_line(struct co_node *node, enum co_node_line_id idx, struct c
 	co_node_unlock(node);
 	return err;
 }
+#else
+int co_node_attach_line(struct co_node *node, enum co_node_line_id idx, struct co_line *line)
+{
+	ARG_UNUSED(node);
+	ARG_UNUSED(idx);
+	ARG_UNUSED(line);
+	return -ENOTSUP;
+}
+#endif
 
 struct co_line *co_node_line(struct co_node *node)
 {
@@ -495,6 +515,7 @@ struct co_line *co_node_get_line(struct co_node *node, enum co_node_line_id idx)
 	return (unsigned int)idx < CO_NODE_LINES ? node->lines[idx].line : NULL;
 }
 
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
 {
 	int err = -EINVAL;
@@ -557,13 +578,6 @@ int co_node_send_routed(struct co_node *node, co_route_t route, const struct can
 	return ret;
 }
 
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-void co_node_assert_locked(const struct co_node *node)
-{
-	CO_ASSERT_LOCKED(&node->lock);
-}
-#endif
-
 co_route_t co_node_route_of(const struct co_node *node, const struct co_rx *rx)
 {
 	/* rx->line is stable while the receiver's handler runs (it holds the node's mutex). */
@@ -607,6 +621,40 @@ int co_node_set_process_route(struct co_node *node, co_route_t route)
 	co_node_unlock(node);
 	return 0;
 }
+#else
+int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
+{
+	ARG_UNUSED(node);
+	return idx == CO_LINE_DEFAULT ? 0 : -EINVAL;
+}
+
+/* The one line is on every route that includes the default line. */
+static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
+{
+	ARG_UNUSED(node);
+	return (route & CO_ROUTE_ON_DEFAULT) != 0U ? CO_ROUTE_DEFAULT : 0U;
+}
+
+void co_node_set_tx_excluded(struct co_node *node, co_route_t lines)
+{
+	/* A route never loses its last line. */
+	ARG_UNUSED(node);
+	ARG_UNUSED(lines);
+}
+
+int co_node_set_process_route(struct co_node *node, co_route_t route)
+{
+	ARG_UNUSED(node);
+	return (route != CO_ROUTE_BOTH && route != CO_ROUTE_ACTIVE) ? -EINVAL : 0;
+}
+#endif
+
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_node_assert_locked(const struct co_node *node)
+{
+	CO_ASSERT_LOCKED(&node->lock);
+}
+#endif
 
 int co_node_tx_withdraw(struct co_node *node, co_route_t route,
 			bool (*keep)(const struct can_frame *frame, void *arg), void *arg)
@@ -679,7 +727,9 @@ int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
 	node->node_id = node_id;
 	node->pending_node_id = node_id;
 	node->nmt.state = CO_NMT_INITIALISING;
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 	node->process_route = CO_ROUTE_BOTH;
+#endif
 	node->services = services;
 	node->n_services = (uint8_t)n_services;
 	sys_slist_init(&node->listeners);

@@ -198,8 +198,8 @@ static void line_hb(struct co_mgr_slave *s, uint64_t now_us)
 	uint8_t l = co_node_rx_line(node);
 	uint8_t o = l == CO_LINE_DEFAULT ? CO_LINE_REDUNDANT : CO_LINE_DEFAULT;
 
-	if (!IS_ENABLED(CONFIG_CANOPEN_REDUNDANCY) || node->lines[CO_LINE_REDUNDANT].line == NULL ||
-	    l >= CO_NODE_LINES) {
+	if (!IS_ENABLED(CONFIG_CANOPEN_REDUNDANCY) ||
+	    co_node_get_line(node, CO_LINE_REDUNDANT) == NULL || l >= CO_NODE_LINES) {
 		return;
 	}
 	s->line_hb_us[l] = now_us;

@@ -292,6 +292,9 @@ ZTEST(co_node, test_node_on_two_lines_sends_on_each_route)
 	struct co_rx rx1;
 	struct co_rx rx2;
 
+	if (!IS_ENABLED(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)) {
+		ztest_test_skip(); /* test_one_line_node_sends_every_route_on_its_line */
+	}
 	zassert_equal(co_node_attach_line(&t.node, CO_LINE_DEFAULT, &t.line2), -EINVAL);
 	zassert_equal(co_node_attach_line(&t.node, CO_LINE_REDUNDANT, &sim.line), -EALREADY,
 		      "the default line again");
@@ -348,17 +351,85 @@ ZTEST(co_node, test_route_to_a_missing_line_is_refused)
 	co_node_unlock(&t.node);
 }
 
+/*
+ * A node with its default line alone, whether it could have a second one or not (scenario
+ * canopen.core.node.one_line: CONFIG_CANOPEN_NODE_REDUNDANT_LINE=n, where
+ * co_node_attach_line() refuses the second one): every route that includes the default line
+ * is that line, whatever the process route and the excluded lines say.
+ */
+ZTEST(co_node, test_one_line_node_sends_every_route_on_its_line)
+{
+	static const co_route_t routes[] = {CO_ROUTE_DEFAULT, CO_ROUTE_BOTH, CO_ROUTE_ACTIVE,
+					    CO_ROUTE_PROCESS, CO_ROUTE_EC};
+	struct can_frame f = {.id = 0x555, .dlc = 1, .data = {0xAA}};
+	struct co_rx rx;
+	int space;
+
+	zassert_ok(co_node_start(&t.node));
+	zassert_equal(co_node_set_active_line(&t.node, CO_LINE_REDUNDANT), -EINVAL);
+	zassert_ok(co_node_set_active_line(&t.node, CO_LINE_DEFAULT));
+	zassert_equal(co_node_set_process_route(&t.node, CO_ROUTE_DEFAULT), -EINVAL);
+	zassert_ok(co_node_set_process_route(&t.node, CO_ROUTE_ACTIVE));
+	co_node_set_tx_excluded(&t.node, CO_ROUTE_DEFAULT);
+	sim.n_sent = 0;
+
+	co_node_lock(&t.node);
+	for (size_t i = 0; i < ARRAY_SIZE(routes); i++) {
+		zassert_ok(co_node_send(&t.node, routes[i], &f), "route %02x", routes[i]);
+	}
+	zassert_equal(co_node_send(&t.node, CO_ROUTE_REDUNDANT, &f), -ENODEV);
+	space = co_node_tx_space(&t.node, CO_ROUTE_DEFAULT);
+	zassert_true(space > 0);
+	zassert_equal(co_node_tx_space(&t.node, CO_ROUTE_EC), space);
+	zassert_equal(co_node_tx_space(&t.node, CO_ROUTE_ACTIVE), space);
+	zassert_equal(co_node_tx_space(&t.node, CO_ROUTE_REDUNDANT), 0);
+	zassert_equal(co_node_rx_line(&t.node), CO_LINE_DEFAULT);
+	zassert_equal(co_node_active_line(&t.node), CO_LINE_DEFAULT);
+	co_rx_init(&rx, 0x321, NULL, &t.node.lock, NULL);
+	zassert_ok(co_node_rx_register(&t.node, CO_LINE_DEFAULT, &rx));
+	zassert_equal(co_node_route_of(&t.node, &rx), CO_ROUTE_DEFAULT);
+	co_node_unlock(&t.node);
+	co_rx_unregister(&rx);
+	zassert_equal(count_id(sim.sent, sim.n_sent, 0x555), (int)ARRAY_SIZE(routes));
+	zassert_is_null(co_node_get_line(&t.node, CO_LINE_REDUNDANT));
+}
+
+ZTEST(co_node, test_second_line_refused_only_on_a_one_line_node)
+{
+	int err;
+
+	err = co_node_attach_line(&t.node, CO_LINE_REDUNDANT, &t.line2);
+	if (IS_ENABLED(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)) {
+		zassert_ok(err);
+		zassert_equal(CO_NODE_LINES, 2U);
+		zassert_equal_ptr(co_node_get_line(&t.node, CO_LINE_REDUNDANT), &t.line2);
+	} else {
+		zassert_equal(err, -ENOTSUP);
+		zassert_equal(co_node_attach_line(&t.node, CO_LINE_DEFAULT, NULL), -ENOTSUP,
+			      "whatever the arguments");
+		zassert_equal(CO_NODE_LINES, 1U);
+		zassert_is_null(co_node_get_line(&t.node, CO_LINE_REDUNDANT));
+	}
+	zassert_ok(co_node_start(&t.node), "the node runs on its default line either way");
+	zassert_equal(co_nmt_get_state(&t.node), CO_NMT_PRE_OPERATIONAL);
+}
+
 ZTEST(co_node, test_line_events_name_their_line)
 {
+	bool two = IS_ENABLED(CONFIG_CANOPEN_NODE_REDUNDANT_LINE);
+
 	add(&t.a, "lines", CO_EV_BIT(CO_EV_LINE));
-	zassert_ok(co_node_attach_line(&t.node, CO_LINE_REDUNDANT, &t.line2));
+	zassert_equal(co_node_attach_line(&t.node, CO_LINE_REDUNDANT, &t.line2),
+		      two ? 0 : -ENOTSUP);
 	zassert_ok(co_node_start(&t.node));
 
 	co_line_inject_event(&sim.line, CO_LINE_EV_CAN_STATE, CAN_STATE_ERROR_PASSIVE);
 	co_line_inject_event(&t.line2, CO_LINE_EV_RX_OVERRUN, 0);
-	zassert_equal(t.a.n, 2);
+	zassert_equal(t.a.n, two ? 2 : 1, "a line the node is not on is not heard");
 	zassert_equal(t.a.line_idx[0], CO_LINE_DEFAULT);
-	zassert_equal(t.a.line_idx[1], CO_LINE_REDUNDANT);
+	if (two) {
+		zassert_equal(t.a.line_idx[1], CO_LINE_REDUNDANT);
+	}
 }
 
 /* --- Stopped ---------------------------------------------------------------------------- */
