@@ -396,8 +396,19 @@ void co_node_set_tx_excluded(struct co_node *node, co_route_t lines);
  * @param arg Passed to @p keep.
  * @return Frames withdrawn (counted in each line's co_line_stats.tx_purged).
  */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_tx_withdraw(struct co_node *node, co_route_t route,
 			bool (*keep)(const struct can_frame *frame, void *arg), void *arg);
+#else
+static inline int co_node_tx_withdraw(struct co_node *node, co_route_t route,
+				      bool (*keep)(const struct can_frame *frame, void *arg),
+				      void *arg)
+{
+	return (route & CO_ROUTE_ON_DEFAULT) != 0U
+		       ? co_line_tx_purge(node->lines[CO_LINE_DEFAULT].line, &node->lock, keep, arg)
+		       : 0;
+}
+#endif
 
 /**
  * @brief Free places in the TX queues of a route (the smallest of its lines).
@@ -405,7 +416,16 @@ int co_node_tx_withdraw(struct co_node *node, co_route_t route,
  * @return Frames that can be sent on every line of the route without an overflow; 0 when the
  *         node has no line on the route.
  */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_tx_space(struct co_node *node, co_route_t route);
+#else
+static inline int co_node_tx_space(struct co_node *node, co_route_t route)
+{
+	return (route & CO_ROUTE_ON_DEFAULT) != 0U
+		       ? co_line_tx_space(node->lines[CO_LINE_DEFAULT].line)
+		       : 0;
+}
+#endif
 
 /**
  * @brief Register a receiver of the node on one of its lines.
@@ -414,7 +434,16 @@ int co_node_tx_space(struct co_node *node, co_route_t route);
  * @retval -ENODEV No line attached at @p idx.
  * @retval other As co_rx_register().
  */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_rx_register(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx);
+#else
+static inline int co_node_rx_register(struct co_node *node, enum co_node_line_id idx,
+				      struct co_rx *rx)
+{
+	return idx == CO_LINE_DEFAULT ? co_rx_register(node->lines[CO_LINE_DEFAULT].line, rx)
+				      : -ENODEV;
+}
+#endif
 
 /**
  * @brief Move a receiver of the node to a new COB-ID on one of its lines.
@@ -423,8 +452,17 @@ int co_node_rx_register(struct co_node *node, enum co_node_line_id idx, struct c
  * @retval -ENODEV No line attached at @p idx.
  * @retval other As co_rx_set_id().
  */
+#if defined(CONFIG_CANOPEN_NODE_REDUNDANT_LINE)
 int co_node_rx_set_id(struct co_node *node, enum co_node_line_id idx, struct co_rx *rx,
 		      uint32_t id);
+#else
+static inline int co_node_rx_set_id(struct co_node *node, enum co_node_line_id idx,
+				    struct co_rx *rx, uint32_t id)
+{
+	return idx == CO_LINE_DEFAULT ? co_rx_set_id(node->lines[CO_LINE_DEFAULT].line, rx, id)
+				      : -ENODEV;
+}
+#endif
 
 /** @brief Arm one of the node's timers (it runs in the default line's thread). */
 void co_node_timer_start(struct co_node *node, struct co_timer *timer, uint64_t deadline_us);

@@ -621,40 +621,6 @@ int co_node_set_process_route(struct co_node *node, co_route_t route)
 	co_node_unlock(node);
 	return 0;
 }
-#else
-int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
-{
-	ARG_UNUSED(node);
-	return idx == CO_LINE_DEFAULT ? 0 : -EINVAL;
-}
-
-/* The one line is on every route that includes the default line. */
-static inline co_route_t route_resolve(const struct co_node *node, co_route_t route)
-{
-	ARG_UNUSED(node);
-	return (route & CO_ROUTE_ON_DEFAULT) != 0U ? CO_ROUTE_DEFAULT : 0U;
-}
-
-void co_node_set_tx_excluded(struct co_node *node, co_route_t lines)
-{
-	/* A route never loses its last line. */
-	ARG_UNUSED(node);
-	ARG_UNUSED(lines);
-}
-
-int co_node_set_process_route(struct co_node *node, co_route_t route)
-{
-	ARG_UNUSED(node);
-	return (route != CO_ROUTE_BOTH && route != CO_ROUTE_ACTIVE) ? -EINVAL : 0;
-}
-#endif
-
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-void co_node_assert_locked(const struct co_node *node)
-{
-	CO_ASSERT_LOCKED(&node->lock);
-}
-#endif
 
 int co_node_tx_withdraw(struct co_node *node, co_route_t route,
 			bool (*keep)(const struct can_frame *frame, void *arg), void *arg)
@@ -696,6 +662,34 @@ int co_node_rx_set_id(struct co_node *node, enum co_node_line_id idx, struct co_
 
 	return line != NULL ? co_rx_set_id(line, rx, id) : -ENODEV;
 }
+#else
+/* co_node_tx_withdraw(), _tx_space(), _rx_register(), _rx_set_id() are inline (node.h). */
+int co_node_set_active_line(struct co_node *node, enum co_node_line_id idx)
+{
+	ARG_UNUSED(node);
+	return idx == CO_LINE_DEFAULT ? 0 : -EINVAL;
+}
+
+void co_node_set_tx_excluded(struct co_node *node, co_route_t lines)
+{
+	/* A route never loses its last line. */
+	ARG_UNUSED(node);
+	ARG_UNUSED(lines);
+}
+
+int co_node_set_process_route(struct co_node *node, co_route_t route)
+{
+	ARG_UNUSED(node);
+	return (route != CO_ROUTE_BOTH && route != CO_ROUTE_ACTIVE) ? -EINVAL : 0;
+}
+#endif
+
+#if defined(CONFIG_CANOPEN_LOCK_CHECK)
+void co_node_assert_locked(const struct co_node *node)
+{
+	CO_ASSERT_LOCKED(&node->lock);
+}
+#endif
 
 void co_node_timer_start(struct co_node *node, struct co_timer *timer, uint64_t deadline_us)
 {

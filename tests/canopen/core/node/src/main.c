@@ -479,6 +479,44 @@ ZTEST(co_node, test_stopped_node_sends_nothing_it_queued_before)
 	co_line_detach(&slow, &n.lines[CO_LINE_DEFAULT].member);
 }
 
+/*
+ * What the node queued while its controller pushed back is withdrawn on every route that
+ * includes its line, and on none without it; receivers move on that line only.
+ */
+ZTEST(co_node, test_one_line_node_withdraws_and_moves_receivers_on_its_line)
+{
+	static struct co_line slow;
+	static struct co_node n;
+	static struct node_test_od_ram ram;
+	struct can_frame f = {.id = 0x555, .dlc = 0};
+	struct co_rx rx;
+	int space;
+
+	blocked = 0;
+	co_line_init_sim(&slow, "slow", slow_sink, NULL);
+	zassert_ok(co_node_init(&n, "n9", &slow, &node_test_od_def, &ram, 9));
+	zassert_ok(co_node_start(&n));
+	blocked = 1;
+	co_node_lock(&n);
+	space = co_node_tx_space(&n, CO_ROUTE_PROCESS);
+	for (int i = 0; i < 3; i++) {
+		zassert_ok(co_node_send(&n, CO_ROUTE_PROCESS, &f), "queued");
+	}
+	zassert_equal(co_node_tx_space(&n, CO_ROUTE_PROCESS), space - 3);
+	zassert_equal(co_node_tx_withdraw(&n, CO_ROUTE_REDUNDANT, NULL, NULL), 0);
+	zassert_equal(co_node_tx_withdraw(&n, CO_ROUTE_EC, NULL, NULL), 3);
+	zassert_equal(co_node_tx_space(&n, CO_ROUTE_DEFAULT), space);
+
+	co_rx_init(&rx, 0x321, NULL, &n.lock, NULL);
+	zassert_equal(co_node_rx_set_id(&n, CO_LINE_REDUNDANT, &rx, 0x322), -ENODEV);
+	zassert_ok(co_node_rx_set_id(&n, CO_LINE_DEFAULT, &rx, 0x322));
+	zassert_equal_ptr(rx.line, &slow);
+	co_node_unlock(&n);
+	co_rx_unregister(&rx);
+	blocked = 0;
+	co_line_detach(&slow, &n.lines[CO_LINE_DEFAULT].member);
+}
+
 /* --- Unconfigured node-ID --------------------------------------------------------------- */
 
 ZTEST(co_node, test_unconfigured_node_stays_silent_until_it_gets_an_id)
