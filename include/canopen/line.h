@@ -161,6 +161,15 @@ struct co_rx {
 	/** @endcond */
 };
 
+/** @cond INTERNAL_HIDDEN */
+/*
+ * A 64-bit time aligned to 4 bytes: a 32-bit target (Cortex-M's LDRD needs no more) then
+ * keeps struct co_timer at 28 instead of 32 bytes. On a typedef, GCC's aligned attribute may
+ * lower the alignment.
+ */
+typedef uint64_t co_time4_t __attribute__((aligned(4)));
+/** @endcond */
+
 /** A deadline bound to a handler. Embedded in a service. */
 struct co_timer {
 	/** Handler; called with @ref lock held. */
@@ -172,12 +181,9 @@ struct co_timer {
 
 	/** @cond INTERNAL_HIDDEN */
 	sys_snode_t node;
-	uint64_t deadline;
+	/* Armed: in the line's list (node.next is NULL only for the last one, and outside). */
+	co_time4_t deadline;
 	struct co_line *line;
-	/* Bit 0: armed (in the line's list); bits 1-31: bumped by every start and stop. One
-	 * word for both keeps the timer at 32 bytes on a 32-bit target (40 with a bool).
-	 */
-	uint32_t gen;
 	/** @endcond */
 };
 
@@ -217,6 +223,12 @@ enum co_line_msg_kind {
 };
 
 struct co_line_rx_msg {
+#if defined(CONFIG_CANOPEN_LINE_SHARED)
+	/* CO_LINE_MSG_LOCAL: lock of the sending node, whose receivers skip the frame. First:
+	 * a 64-bit host then packs the rest behind it (32 bytes, not 40).
+	 */
+	const struct k_mutex *origin;
+#endif
 	struct can_frame frame;
 	/*
 	 * Low 32 bits of the reception time [µs]: a message waits far less than the 35 minutes
@@ -224,10 +236,6 @@ struct co_line_rx_msg {
 	 * time the message would be 8-aligned: 32 instead of 24 bytes (28 on a shared line).
 	 */
 	uint32_t time_lo;
-#if defined(CONFIG_CANOPEN_LINE_SHARED)
-	/* CO_LINE_MSG_LOCAL: lock of the sending node, whose receivers skip the frame. */
-	const struct k_mutex *origin;
-#endif
 	uint8_t kind;
 };
 
@@ -253,6 +261,11 @@ struct co_line {
 	uint32_t rx_seq;
 	/* Armed timers sorted by deadline. */
 	sys_slist_t timers;
+	/*
+	 * The timer co_line_process() took off the list and is about to run; a start or stop
+	 * of it meanwhile (by its owner, in another thread) clears this, and it does not run.
+	 */
+	struct co_timer *popped;
 	/* Serialises changes of the receive table, protects the timer list. Leaf lock: never
 	 * held while a node lock is taken.
 	 */
@@ -293,10 +306,11 @@ struct co_line {
 	/* Threaded mode. */
 	const struct device *dev;
 	char rxq_buf[CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE * sizeof(struct co_line_rx_msg)];
-	struct k_thread thread;
 	k_tid_t tid;
 	int filter_std;
 	int filter_ext;
+	/* After the three words above: in the 32-bit footprint build, on its 16-byte alignment. */
+	struct k_thread thread;
 	atomic_t flags;
 	atomic_t can_state;
 	atomic_t tx_async_err;

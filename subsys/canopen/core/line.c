@@ -46,7 +46,7 @@ uint64_t co_line_now(void)
 uint64_t co_line_time(const struct co_line *line)
 {
 #if defined(CONFIG_CANOPEN_LINE_SIM)
-	if (line->dev == NULL) {
+	if (co_line_is_sim(line)) {
 		return line->sim_now;
 	}
 #endif
@@ -57,7 +57,7 @@ uint64_t co_line_time(const struct co_line *line)
 static inline void sim_advance(struct co_line *line, uint64_t now_us)
 {
 #if defined(CONFIG_CANOPEN_LINE_SIM)
-	if (line->dev == NULL && co_time_before_eq(line->sim_now, now_us)) {
+	if (co_line_is_sim(line) && co_time_before_eq(line->sim_now, now_us)) {
 		line->sim_now = now_us;
 	}
 #else
@@ -753,16 +753,25 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
 	timer->user_data = user_data;
 }
 
-/* co_timer.gen: bit 0 is set while the timer is in the line's list. */
-#define TIMER_ARMED 1U
+/*
+ * Whether a timer is in its line's list: every removal (sys_slist_remove()) and the insert at
+ * the tail clear node.next, so outside the list it is NULL, as for the last timer in it.
+ */
+static bool timer_armed(const struct co_line *line, const struct co_timer *timer)
+{
+	return sys_slist_peek_next_no_check(&timer->node) != NULL ||
+	       sys_slist_peek_tail(&line->timers) == &timer->node;
+}
 
 static void timer_unlink(struct co_line *line, struct co_timer *timer)
 {
-	if ((timer->gen & TIMER_ARMED) != 0U) {
-		sys_slist_find_and_remove(&line->timers, &timer->node);
+	if (timer_armed(line, timer)) {
+		(void)sys_slist_find_and_remove(&line->timers, &timer->node);
 	}
-	/* Any start or stop makes a timer popped earlier stale: disarmed, count bumped. */
-	timer->gen = (timer->gen & ~TIMER_ARMED) + 2U;
+	/* Any start or stop makes the timer stale if co_line_process() has just taken it. */
+	if (line->popped == timer) {
+		line->popped = NULL;
+	}
 }
 
 void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us)
@@ -789,7 +798,6 @@ void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadl
 		prev = cur;
 	}
 	sys_slist_insert(&line->timers, prev, &timer->node);
-	timer->gen |= TIMER_ARMED;
 	first = (prev == NULL);
 	k_mutex_unlock(&line->lock);
 
@@ -819,7 +827,7 @@ bool co_timer_is_armed(const struct co_timer *timer)
 		return false;
 	}
 	k_mutex_lock(&line->lock, K_FOREVER);
-	armed = (timer->gen & TIMER_ARMED) != 0U;
+	armed = timer_armed(line, timer);
 	k_mutex_unlock(&line->lock);
 	return armed;
 }
@@ -839,7 +847,7 @@ uint64_t co_line_next_deadline(struct co_line *line)
 }
 
 /* Take the first expired timer off the list, or return NULL. */
-static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us, uint32_t *gen)
+static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us)
 {
 	struct co_timer *t = NULL;
 	sys_snode_t *head;
@@ -850,9 +858,9 @@ static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us,
 		struct co_timer *first = CONTAINER_OF(head, struct co_timer, node);
 
 		if (co_time_before_eq(first->deadline, now_us)) {
-			sys_slist_get_not_empty(&line->timers);
-			first->gen &= ~TIMER_ARMED;
-			*gen = first->gen;
+			/* Not sys_slist_get(): Zephyr's leaves node.next as it was. */
+			sys_slist_remove(&line->timers, NULL, head);
+			line->popped = first;
 			t = first;
 		}
 	}
@@ -863,7 +871,6 @@ static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us,
 uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 {
 	struct co_timer *t;
-	uint32_t gen = 0U;
 
 	if (co_line_is_sim(line)) {
 		k_mutex_lock(&line->lock, K_FOREVER);
@@ -879,7 +886,7 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 	 * zero-period timer cannot starve the line.
 	 */
 	for (int budget = 4 * CONFIG_CANOPEN_LINE_RX_SLOTS; budget > 0; budget--) {
-		t = timer_pop_expired(line, now_us, &gen);
+		t = timer_pop_expired(line, now_us);
 		if (t == NULL) {
 			break;
 		}
@@ -890,7 +897,8 @@ uint64_t co_line_process(struct co_line *line, uint64_t now_us)
 		}
 		/* Started or stopped by another thread since it was popped: not due any more. */
 		k_mutex_lock(&line->lock, K_FOREVER);
-		due = t->gen == gen && t->line == line;
+		due = line->popped == t && t->line == line;
+		line->popped = NULL;
 		k_mutex_unlock(&line->lock);
 		if (due) {
 			t->handler(t, now_us);

@@ -41,7 +41,10 @@ static inline bool co_line_is_sim(const struct co_line *line)
  */
 static inline uint64_t co_line_msg_time(const struct co_line_rx_msg *msg, uint64_t ref)
 {
-	return ref + (uint64_t)(int64_t)(int32_t)(msg->time_lo - (uint32_t)ref);
+	uint32_t diff = msg->time_lo - (uint32_t)ref;
+	int32_t ahead = (int32_t)diff;
+
+	return ref + (uint64_t)(int64_t)ahead;
 }
 
 /* Wake the line thread so it re-reads its deadline (no-op in simulation). */

@@ -344,6 +344,52 @@ ZTEST(co_line, test_restart_replaces_the_deadline_and_stop_disarms)
 	co_timer_stop(&a.t); /* stopping twice is harmless */
 }
 
+static bool armed_in_handler;
+
+static void armed_handler(struct co_timer *timer, uint64_t now_us)
+{
+	armed_in_handler = co_timer_is_armed(timer);
+}
+
+/*
+ * Armed means in the line's list, wherever: at the head, in the middle, or last (which has
+ * no successor, as a timer outside the list); a timer whose handler runs is not armed.
+ */
+ZTEST(co_line, test_a_timer_is_armed_wherever_it_is_in_the_list)
+{
+	struct tagged_timer a = {.tag = 1}, b = {.tag = 2}, c = {.tag = 3};
+	struct co_timer d;
+
+	co_timer_init(&a.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_init(&b.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_init(&c.t, timer_handler, &fx.node_lock, NULL);
+	co_timer_init(&d, armed_handler, &fx.node_lock, NULL);
+	zassert_false(co_timer_is_armed(&a.t), "never started");
+	co_timer_start(&fx.line, &a.t, 1000);
+	zassert_true(co_timer_is_armed(&a.t), "alone in the list");
+	co_timer_start(&fx.line, &b.t, 2000);
+	co_timer_start(&fx.line, &c.t, 3000);
+	zassert_true(co_timer_is_armed(&a.t) && co_timer_is_armed(&b.t) && co_timer_is_armed(&c.t));
+	co_timer_stop(&b.t);
+	zassert_false(co_timer_is_armed(&b.t), "taken from the middle");
+	zassert_true(co_timer_is_armed(&a.t) && co_timer_is_armed(&c.t));
+	co_timer_stop(&c.t);
+	zassert_false(co_timer_is_armed(&c.t), "taken from the end");
+	zassert_true(co_timer_is_armed(&a.t), "now the last one");
+	co_timer_start(&fx.line, &c.t, 500);
+	zassert_true(co_timer_is_armed(&c.t) && co_timer_is_armed(&a.t));
+	zassert_equal(co_line_process(&fx.line, 1000), UINT64_MAX);
+	zassert_equal(fx.log_len, 2);
+	zassert_false(co_timer_is_armed(&a.t) || co_timer_is_armed(&c.t), "run: disarmed");
+
+	armed_in_handler = true;
+	co_timer_start(&fx.line, &d, 2000);
+	co_timer_start(&fx.line, &b.t, 2000);
+	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
+	zassert_false(armed_in_handler, "not armed while its handler runs");
+	zassert_equal(b.fired, 1, "the next one still runs");
+}
+
 static K_THREAD_STACK_DEFINE(processor_stack, 4096);
 static struct k_thread processor;
 
