@@ -65,6 +65,11 @@ extern "C" {
 #else
 #define CO_OD_PROVIDERS 0
 #endif
+/*
+ * Without both, an object's co_od_info is rebuilt from its descriptor (co_od_info_fill()), and
+ * a PDO mapping entry keeps only that descriptor (CO_PDO_ENT_COMPACT): one condition for both.
+ */
+#define CO_OD_INFO_COMPACT (!CO_OD_COVER && !CO_OD_PROVIDERS)
 #ifdef CONFIG_CANOPEN_OD_PROVIDERS_MAX
 #define CO_OD_PROVIDERS_MAX CONFIG_CANOPEN_OD_PROVIDERS_MAX
 #elif CO_OD_PROVIDERS
@@ -327,7 +332,7 @@ struct co_od_hook_ent {
 	uint8_t sub_first;
 	uint8_t sub_last;
 	uint8_t kind; /* CO_OD_HOOK_ENT_* */
-	union {
+	union co_od_hook_fn {
 		co_od_validate_cb validate;
 		co_od_read_check_cb read_check;
 	} fn;

@@ -912,7 +912,7 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
 			return 0;
 		}
 	}
-#if !CO_OD_COVER && !CO_OD_PROVIDERS
+#if CO_OD_INFO_COMPACT
 	/* One copy, shared with the compact PDO mapping entries of such a build. */
 	co_od_info_fill(od, desc, index, e->objcode, e->group, info);
 #else
