@@ -119,11 +119,7 @@ typedef void (*co_tpdo_ind_t)(struct co_node *node, uint16_t num, void *user_dat
  * only what rebuilds its object's co_od_info (co_od_info_fill()) when a frame accesses it:
  * 8 instead of 24 bytes on a 32-bit target, for a few instructions per mapped object.
  */
-#if !CO_OD_COVER && !CO_OD_PROVIDERS
-#define CO_PDO_ENT_COMPACT 1
-#else
-#define CO_PDO_ENT_COMPACT 0
-#endif
+#define CO_PDO_ENT_COMPACT CO_OD_INFO_COMPACT
 
 /* One mapped object, resolved once when the mapping is enabled. */
 struct co_pdo_map_ent {
