@@ -26,6 +26,7 @@
 
 #include <canopen/event.h>
 #include <canopen/line.h>
+#include <canopen/redundancy.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -146,13 +147,7 @@ struct co_emcy {
 	void *ind_user_data;
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 	/* Two lines: the last EMCY frames taken, each matched once by its copy from the other. */
-	struct {
-		uint64_t at;
-		uint16_t id;
-		uint8_t data[8];
-		uint8_t line;
-		bool copied;
-	} taken[4];
+	struct co_rdn_taken taken[4];
 	uint8_t taken_next;
 #endif
 };

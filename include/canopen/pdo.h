@@ -30,6 +30,7 @@
 #include <canopen/line.h>
 #include <canopen/event.h>
 #include <canopen/od.h>
+#include <canopen/redundancy.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -173,13 +174,7 @@ struct co_rpdo {
 	bool sync_pending;
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 	/* The last frames taken, to drop their copies from the other line (redundancy). */
-	struct co_rpdo_taken {
-		uint64_t at;
-		uint8_t data[8];
-		uint8_t dlc;
-		uint8_t line;
-		bool copied; /* its copy from the other line came already */
-	} taken[CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH];
+	struct co_rdn_taken taken[CONFIG_CANOPEN_REDUNDANCY_DUP_DEPTH];
 	uint8_t taken_next;
 #endif
 };

@@ -110,6 +110,29 @@ typedef bool (*co_rdn_veto_t)(struct co_node *node, enum co_rdn_event why, uint8
 
 /** @cond INTERNAL_HIDDEN */
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
+/*
+ * A frame taken from one line, waiting for its copy from the other (the duplicate filter of
+ * RPDOs and EMCY consumers, co_rdn_is_copy()). All-zero is an empty entry.
+ */
+struct co_rdn_taken {
+	uint64_t at;
+	uint16_t id;
+	uint8_t data[8];
+	uint8_t len;
+	uint8_t line;
+	bool used;
+	bool copied; /* its copy from the other line came already */
+};
+
+/*
+ * Whether @p frame, received on @p line at @p now_us, is the other line's copy of a frame in
+ * @p ring (@p n entries, the oldest at *@p next). If not, it is taken: it replaces the oldest
+ * entry. Each taken frame has one copy: same CAN-ID, length and data, from the other line,
+ * within CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US.
+ */
+bool co_rdn_is_copy(struct co_rdn_taken *ring, uint8_t n, uint8_t *next, uint8_t line,
+		    const struct can_frame *frame, uint64_t now_us);
+
 /* One supervised node's heartbeat on one line. */
 struct co_rdn_hb {
 	uint64_t deadline;

@@ -326,49 +326,6 @@ static void inhibit_notify(struct co_od *od, const struct co_od_req *req, void *
 
 /* Without consumer entries (CONFIG_CANOPEN_EMCY_CONSUMERS=0) nothing below is built. */
 #if CONFIG_CANOPEN_EMCY_CONSUMERS > 0
-#if defined(CONFIG_CANOPEN_REDUNDANCY)
-/*
- * A node on two lines hears an EMCY on both (the producer sends it on both): the same frame
- * from the other line within the PDO copies' window is the copy of one taken there, each
- * taken frame has one copy, and a copy ends the wait for the copies of that producer's older
- * frames (a line keeps the order sent: it lost them), as for RPDOs. A repeat on the same line
- * is a new emergency.
- */
-static bool cons_copy(struct co_emcy *em, uint8_t line, const struct can_frame *frame,
-		      uint64_t now_us)
-{
-	for (uint8_t k = 0; k < ARRAY_SIZE(em->taken); k++) {
-		/* Oldest first, as the PDO filter: equal frames pair with their copies in order. */
-		uint8_t i = (uint8_t)((em->taken_next + k) % ARRAY_SIZE(em->taken));
-		uint64_t age = now_us >= em->taken[i].at ? now_us - em->taken[i].at
-							 : em->taken[i].at - now_us;
-
-		if (em->taken[i].at != 0U && !em->taken[i].copied && em->taken[i].line != line &&
-		    em->taken[i].id == frame->id &&
-		    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
-		    memcmp(em->taken[i].data, frame->data, 8) == 0) {
-			for (uint8_t j = 0; j <= k; j++) {
-				uint8_t o = (uint8_t)((em->taken_next + j) % ARRAY_SIZE(em->taken));
-
-				if (em->taken[o].line != line && em->taken[o].id == frame->id) {
-					em->taken[o].copied = true;
-				}
-			}
-			return true;
-		}
-	}
-	uint8_t i = em->taken_next;
-
-	em->taken_next = (uint8_t)((i + 1U) % ARRAY_SIZE(em->taken));
-	em->taken[i].at = now_us != 0U ? now_us : 1U;
-	em->taken[i].id = (uint16_t)frame->id;
-	em->taken[i].line = line;
-	em->taken[i].copied = false;
-	memcpy(em->taken[i].data, frame->data, 8);
-	return false;
-}
-#endif
-
 static void cons_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
 {
 	struct co_node *node = rx->user_data;
@@ -381,7 +338,14 @@ static void cons_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t no
 		return;
 	}
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
-	if (cons_copy(em, co_node_rx_line(node), frame, now_us)) {
+	/*
+	 * A node on two lines hears an EMCY on both (the producer sends it on both): the same
+	 * frame from the other line within the window is the copy of one taken there, and a copy
+	 * ends the wait for the copies of that producer's (CAN-ID's) older frames, as for RPDOs.
+	 * A repeat on the same line is a new emergency.
+	 */
+	if (co_rdn_is_copy(em->taken, (uint8_t)ARRAY_SIZE(em->taken), &em->taken_next,
+			   co_node_rx_line(node), frame, now_us)) {
 		return;
 	}
 #endif

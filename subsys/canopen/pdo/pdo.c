@@ -307,40 +307,11 @@ static bool rpdo_duplicate(struct co_rpdo *r, const struct can_frame *frame, uin
 		return true;
 	}
 
-	for (uint8_t k = 0; k < ARRAY_SIZE(r->taken); k++) {
-		/* Oldest first: equal values pair with their copies in order. */
-		struct co_rpdo_taken *e = &r->taken[(r->taken_next + k) % ARRAY_SIZE(r->taken)];
-		uint64_t age = now_us >= e->at ? now_us - e->at : e->at - now_us;
-
-		if (!e->copied && e->line != line && e->dlc == frame->dlc && e->dlc != 0xffU &&
-		    age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
-		    memcmp(frame->data, e->data, frame->dlc) == 0) {
-			/*
-			 * A line delivers one producer's frames in the order sent: the older
-			 * frames taken from the other line that this line has not copied yet, it
-			 * lost. They can have no copy any more, so a later value equal to one of
-			 * them is not mistaken for it.
-			 */
-			for (uint8_t j = 0; j <= k; j++) {
-				struct co_rpdo_taken *o =
-					&r->taken[(r->taken_next + j) % ARRAY_SIZE(r->taken)];
-
-				if (o->line != line) {
-					o->copied = true;
-				}
-			}
-			r->node->pdo.rx_duplicates++;
-			return true;
-		}
+	if (co_rdn_is_copy(r->taken, (uint8_t)ARRAY_SIZE(r->taken), &r->taken_next, line, frame,
+			   now_us)) {
+		r->node->pdo.rx_duplicates++;
+		return true;
 	}
-	struct co_rpdo_taken *e = &r->taken[r->taken_next];
-
-	r->taken_next = (uint8_t)((r->taken_next + 1U) % ARRAY_SIZE(r->taken));
-	e->at = now_us;
-	e->line = line;
-	e->dlc = frame->dlc;
-	e->copied = false;
-	memcpy(e->data, frame->data, frame->dlc);
 	return false;
 }
 #endif
@@ -429,9 +400,7 @@ static void rpdo_configure(struct co_rpdo *r)
 
 #if defined(CONFIG_CANOPEN_REDUNDANCY)
 	/* Nothing taken yet: no frame is anybody's copy. */
-	for (uint8_t k = 0; k < ARRAY_SIZE(r->taken); k++) {
-		r->taken[k].dlc = 0xffU;
-	}
+	(void)memset(r->taken, 0, sizeof(r->taken));
 #endif
 
 	co_timer_stop(&r->timer);

@@ -596,3 +596,45 @@ uint8_t co_redundancy_get(struct co_node *node, enum co_rdn_state *state, uint32
 	co_node_unlock(node);
 	return line;
 }
+
+/* --- Duplicate filter: the copies of frames taken from the other line -------------------- */
+
+bool co_rdn_is_copy(struct co_rdn_taken *ring, uint8_t n, uint8_t *next, uint8_t line,
+		    const struct can_frame *frame, uint64_t now_us)
+{
+	for (uint8_t k = 0U; k < n; k++) {
+		/* Oldest first: equal values pair with their copies in the order sent. */
+		struct co_rdn_taken *e = &ring[(*next + k) % n];
+		uint64_t age = now_us >= e->at ? now_us - e->at : e->at - now_us;
+
+		if (e->used && !e->copied && e->line != line && e->id == (uint16_t)frame->id &&
+		    e->len == frame->dlc && age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
+		    memcmp(frame->data, e->data, frame->dlc) == 0) {
+			/*
+			 * A line delivers one producer's frames in the order sent: the older
+			 * frames of this producer taken from the other line that this line has
+			 * not copied yet, it lost. They can have no copy any more, so a later
+			 * value equal to one of them is not mistaken for it.
+			 */
+			for (uint8_t j = 0U; j <= k; j++) {
+				struct co_rdn_taken *o = &ring[(*next + j) % n];
+
+				if (o->line != line && o->id == e->id) {
+					o->copied = true;
+				}
+			}
+			return true;
+		}
+	}
+
+	struct co_rdn_taken *e = &ring[*next];
+
+	*next = (uint8_t)((*next + 1U) % n);
+	*e = (struct co_rdn_taken){.at = now_us,
+				   .id = (uint16_t)frame->id,
+				   .len = frame->dlc,
+				   .line = line,
+				   .used = true};
+	(void)memcpy(e->data, frame->data, MIN(frame->dlc, sizeof(e->data)));
+	return false;
+}
