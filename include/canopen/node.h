@@ -185,7 +185,7 @@ int co_node_init(struct co_node *node, const char *name, struct co_line *line,
  *
  * @retval 0 Attached.
  * @retval -ENOTSUP The node can have one line only (built without
- *         CONFIG_CANOPEN_NODE_REDUNDANT_LINE, which CONFIG_CANOPEN_REDUNDANCY selects), whatever
+ *         CONFIG_CANOPEN_NODE_REDUNDANT_LINE, always on with CONFIG_CANOPEN_REDUNDANCY), whatever
  *         the arguments.
  * @retval -EINVAL A NULL argument, or @p idx is not CO_LINE_REDUNDANT.
  * @retval -EALREADY A line is attached there already, or it is the default line.
