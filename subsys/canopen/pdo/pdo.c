@@ -807,104 +807,60 @@ static uint32_t cob_id_check(uint32_t cur, uint64_t v)
 	return 0U;
 }
 
-static uint32_t rpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
-{
-	struct co_rpdo *r = rpdo_of(user_data, req->info->index, IDX_RPDO_COMM);
-	uint64_t v = co_od_req_uint(req);
-
-	if (r == NULL || req->writer == CO_OD_WRITER_STORAGE) {
-		return 0U;
-	}
-	switch (req->info->sub) {
-	case SUB_COB_ID:
-		return cob_id_check(r->cob_id, v);
-	case SUB_TYPE:
-		/* 241..253 are reserved for RPDOs (CiA 301 §7.5.2.35). */
-		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_EVENT_MANUF) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
-		if (!sync_type_served((uint8_t)v)) {
-			return CO_SDO_AB_INVALID_VALUE;
-		}
-		/* MPDOs are event-driven only. */
-		return r->mpdo != 0U && !is_event_type((uint8_t)v) ? AB_PDO_STATE : 0U;
-	default:
-		return 0U;
-	}
-}
-
-static void rpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
-{
-	struct co_rpdo *r = rpdo_of(user_data, req->info->index, IDX_RPDO_COMM);
-	uint64_t v = co_od_req_uint(req);
-
-	if (r == NULL || req->writer == CO_OD_WRITER_STORAGE) {
-		return;
-	}
-	switch (req->info->sub) {
-	case SUB_COB_ID:
-		r->cob_id = (uint32_t)v;
-		rpdo_configure(r);
-		break;
-	case SUB_TYPE:
-		r->type = (uint8_t)v;
-		r->sync_pending = false;
-		break;
-	case SUB_EVENT:
-		r->event_ms = (uint16_t)v;
-		if (r->event_ms == 0U) {
-			co_timer_stop(&r->timer);
-			rpdo_error(r, ERR_TIMEOUT, false);
-		} else if (co_timer_is_armed(&r->timer)) {
-			co_node_timer_start(r->node, &r->timer,
-					    co_node_time(r->node) + (uint64_t)r->event_ms * 1000U);
-		}
-		break;
-	default:
-		break;
-	}
-}
-
-static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
+/*
+ * One validate for the RPDO (1400h..) and TPDO (1800h..) communication records: the checks
+ * they share are written once; the TPDO-only ones follow the shared ones as before.
+ */
+static uint32_t comm_validate(struct co_od *od, struct co_od_req *req, void *user_data)
 {
 	struct co_node *node = user_data;
-	struct co_tpdo *t = tpdo_of(node, req->info->index, IDX_TPDO_COMM);
+	uint16_t index = req->info->index;
+	bool rx = index < IDX_TPDO_COMM;
+	struct co_rpdo *r = rx ? rpdo_of(node, index, IDX_RPDO_COMM) : NULL;
+	struct co_tpdo *t = rx ? NULL : tpdo_of(node, index, IDX_TPDO_COMM);
 	uint64_t v = co_od_req_uint(req);
-	bool valid;
+	uint32_t cob_id;
+	uint8_t mpdo;
 
-	if (t == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+	if ((r == NULL && t == NULL) || req->writer == CO_OD_WRITER_STORAGE) {
 		return 0U;
 	}
-	valid = cob_valid(t->cob_id);
+	cob_id = rx ? r->cob_id : t->cob_id;
+	mpdo = rx ? r->mpdo : t->mpdo;
 	switch (req->info->sub) {
 	case SUB_COB_ID: {
-		uint32_t ab = cob_id_check(t->cob_id, v);
+		uint32_t ab = cob_id_check(cob_id, v);
 
 		/* An RTR-only TPDO needs remote requests. */
-		if (ab == 0U && (v & CO_PDO_COB_NO_RTR) != 0U && is_rtr_type(t->type)) {
+		if (!rx && ab == 0U && (v & CO_PDO_COB_NO_RTR) != 0U && is_rtr_type(t->type)) {
 			ab = CO_SDO_AB_INVALID_VALUE;
 		}
 		return ab;
 	}
 	case SUB_TYPE:
-		if (v > CO_PDO_TT_SYNC_MAX && v < CO_PDO_TT_RTR_SYNC) {
+		/* 241..253 are reserved for RPDOs, 241..251 for TPDOs (CiA 301 §7.5.2.35). */
+		if (v > CO_PDO_TT_SYNC_MAX &&
+		    v < (rx ? CO_PDO_TT_EVENT_MANUF : CO_PDO_TT_RTR_SYNC)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
 		if (!sync_type_served((uint8_t)v)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
-		if (is_rtr_type((uint8_t)v) && (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) ||
-						(t->cob_id & CO_PDO_COB_NO_RTR) != 0U)) {
+		if (!rx && is_rtr_type((uint8_t)v) &&
+		    (!IS_ENABLED(CONFIG_CANOPEN_PDO_RTR) || (cob_id & CO_PDO_COB_NO_RTR) != 0U)) {
 			return CO_SDO_AB_INVALID_VALUE;
 		}
-		if (t->mpdo != 0U && !is_event_type((uint8_t)v)) {
+		if (mpdo != 0U && !is_event_type((uint8_t)v)) {
 			return AB_PDO_STATE; /* MPDOs are event-driven only */
 		}
-		return cos_hooks_fit(node, t, &t->map, (uint8_t)v);
+		return rx ? 0U : cos_hooks_fit(node, t, &t->map, (uint8_t)v);
 	case SUB_INHIBIT:
-		return valid ? AB_PDO_STATE : 0U;
+		return !rx && cob_valid(cob_id) ? AB_PDO_STATE : 0U;
 	case SUB_SYNC_START:
-		if (valid) {
+		if (rx) {
+			return 0U;
+		}
+		if (cob_valid(cob_id)) {
 			return AB_PDO_STATE;
 		}
 		return v > CO_PDO_TT_SYNC_MAX ? CO_SDO_AB_INVALID_VALUE : 0U;
@@ -913,12 +869,49 @@ static uint32_t tpdo_comm_validate(struct co_od *od, struct co_od_req *req, void
 	}
 }
 
-static void tpdo_comm_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+/* One notify for the RPDO and TPDO communication records (one prologue). */
+static void comm_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
 {
-	struct co_tpdo *t = tpdo_of(user_data, req->info->index, IDX_TPDO_COMM);
+	uint16_t index = req->info->index;
 	uint64_t v = co_od_req_uint(req);
 
-	if (t == NULL || req->writer == CO_OD_WRITER_STORAGE) {
+	if (req->writer == CO_OD_WRITER_STORAGE) {
+		return;
+	}
+	if (index < IDX_TPDO_COMM) {
+		struct co_rpdo *r = rpdo_of(user_data, index, IDX_RPDO_COMM);
+
+		if (r == NULL) {
+			return;
+		}
+		switch (req->info->sub) {
+		case SUB_COB_ID:
+			r->cob_id = (uint32_t)v;
+			rpdo_configure(r);
+			break;
+		case SUB_TYPE:
+			r->type = (uint8_t)v;
+			r->sync_pending = false;
+			break;
+		case SUB_EVENT:
+			r->event_ms = (uint16_t)v;
+			if (r->event_ms == 0U) {
+				co_timer_stop(&r->timer);
+				rpdo_error(r, ERR_TIMEOUT, false);
+			} else if (co_timer_is_armed(&r->timer)) {
+				co_node_timer_start(r->node, &r->timer,
+						    co_node_time(r->node) +
+							    (uint64_t)r->event_ms * 1000U);
+			}
+			break;
+		default:
+			break;
+		}
+		return;
+	}
+	struct co_tpdo *t = tpdo_of(user_data, index, IDX_TPDO_COMM);
+
+	if (t == NULL) {
 		return;
 	}
 	switch (req->info->sub) {
@@ -1060,8 +1053,8 @@ static const struct co_od_hook pdo_hooks[] = {
 		.index_first = IDX_RPDO_COMM,
 		.sub_first = 1,
 		.sub_last = 6,
-		.validate = rpdo_comm_validate,
-		.notify = rpdo_comm_notify,
+		.validate = comm_validate,
+		.notify = comm_notify,
 	},
 	{
 		.index_first = IDX_RPDO_MAP,
@@ -1074,8 +1067,8 @@ static const struct co_od_hook pdo_hooks[] = {
 		.index_first = IDX_TPDO_COMM,
 		.sub_first = 1,
 		.sub_last = 6,
-		.validate = tpdo_comm_validate,
-		.notify = tpdo_comm_notify,
+		.validate = comm_validate,
+		.notify = comm_notify,
 	},
 	{
 		.index_first = IDX_TPDO_MAP,
