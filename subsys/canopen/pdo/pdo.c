@@ -1095,7 +1095,7 @@ static int pdo_init(struct co_node *node)
 
 		r->node = node;
 		r->num = i;
-		r->present = od_has(node, IDX_RPDO_COMM + i) && od_has(node, IDX_RPDO_MAP + i);
+		r->present = true; /* cleared below unless both records exist */
 		r->cob_id = CO_PDO_COB_INVALID;
 		co_rx_init(&r->rx, 0U, rpdo_rx, &node->lock, r);
 		co_timer_init(&r->timer, rpdo_timeout, &node->lock, r);
@@ -1105,7 +1105,7 @@ static int pdo_init(struct co_node *node)
 
 		t->node = node;
 		t->num = i;
-		t->present = od_has(node, IDX_TPDO_COMM + i) && od_has(node, IDX_TPDO_MAP + i);
+		t->present = true;
 		t->cob_id = CO_PDO_COB_INVALID;
 #if defined(CONFIG_CANOPEN_PDO_RTR)
 		co_rx_init(&t->rx, 0U, tpdo_rtr, &node->lock, t);
@@ -1113,12 +1113,23 @@ static int pdo_init(struct co_node *node)
 		co_timer_init(&t->inhibit_timer, tpdo_inhibit_expired, &node->lock, t);
 		co_timer_init(&t->event_timer, tpdo_event_expired, &node->lock, t);
 	}
-	/* More PDOs in the dictionary than instances: refuse rather than ignore them. */
+	/*
+	 * One scan per record kind: an instance is present with both its records; more PDOs in
+	 * the dictionary than instances are refused rather than ignored.
+	 */
 	for (size_t h = 0; h < ARRAY_SIZE(pdo_hooks); h++) {
 		bool rx = h < 2U;
 
-		for (uint16_t i = pdo_count(rx); i < 512U; i++) {
-			if (od_has(node, pdo_hooks[h].index_first + i)) {
+		for (uint16_t i = 0; i < 512U; i++) {
+			bool has = od_has(node, pdo_hooks[h].index_first + i);
+
+			if (i < pdo_count(rx)) {
+				if (!has && rx) {
+					pdo->rpdo[i].present = false;
+				} else if (!has) {
+					pdo->tpdo[i].present = false;
+				}
+			} else if (has) {
 				LOG_ERR("%s: %cPDO %u in the dictionary, CONFIG_CANOPEN_%cPDOS=%d",
 					node->name, rx ? 'R' : 'T', i, rx ? 'R' : 'T',
 					rx ? CO_RPDOS : CO_TPDOS);
