@@ -850,4 +850,55 @@ ZTEST(can_virtual, test_realtime_state_changes_arrive_in_order)
 	zassert_equal(states[2], CAN_STATE_ERROR_ACTIVE);
 }
 
+static K_THREAD_STACK_ARRAY_DEFINE(queue_setter_stacks, 5, 4096);
+static struct k_thread queue_setters[5];
+
+/*
+ * Five changes while the callback holds the first one: the queue keeps four, and the fifth
+ * takes the place of the newest, so the state the controller ends in is still the last one
+ * the callback sees (doc/can-virtual.md).
+ */
+ZTEST(can_virtual, test_realtime_full_state_queue_keeps_the_last_state)
+{
+	static const enum can_state seq[5] = {CAN_STATE_ERROR_PASSIVE, CAN_STATE_ERROR_ACTIVE,
+					      CAN_STATE_ERROR_WARNING, CAN_STATE_ERROR_PASSIVE,
+					      CAN_STATE_ERROR_ACTIVE};
+	enum can_state now;
+
+	can_set_state_change_callback(c[0], holding_state_cb, NULL);
+	k_sem_reset(&held_cb_entered);
+	k_sem_reset(&held_cb_release);
+	k_thread_create(&setters[0], setter_stacks[0], K_THREAD_STACK_SIZEOF(setter_stacks[0]),
+			set_state_thread, (void *)(intptr_t)CAN_STATE_ERROR_WARNING, NULL, NULL, 0,
+			0, K_NO_WAIT);
+	zassert_ok(k_sem_take(&held_cb_entered, K_SECONDS(5)));
+
+	/* One thread per change (each waits for the callback); each change made before the next. */
+	for (int k = 0; k < 5; k++) {
+		k_thread_create(&queue_setters[k], queue_setter_stacks[k],
+				K_THREAD_STACK_SIZEOF(queue_setter_stacks[k]), set_state_thread,
+				(void *)(intptr_t)seq[k], NULL, NULL, 0, 0, K_NO_WAIT);
+		now = CAN_STATE_STOPPED;
+		for (int i = 0; i < 500 && now != seq[k]; i++) {
+			k_usleep(100);
+			zassert_ok(can_get_state(c[0], &now, NULL));
+		}
+		zassert_equal(now, seq[k], "change %d made", k);
+	}
+	zassert_equal(n_states, 1, "only the first change has reached the callback");
+
+	k_sem_give(&held_cb_release);
+	zassert_ok(k_thread_join(&setters[0], K_SECONDS(5)));
+	for (int k = 0; k < 5; k++) {
+		zassert_ok(k_thread_join(&queue_setters[k], K_SECONDS(5)));
+	}
+	zassert_equal(n_states, 5, "the first change and the four queued (%d)", n_states);
+	zassert_equal(states[0], CAN_STATE_ERROR_WARNING);
+	zassert_equal(states[1], CAN_STATE_ERROR_PASSIVE);
+	zassert_equal(states[2], CAN_STATE_ERROR_ACTIVE);
+	zassert_equal(states[3], CAN_STATE_ERROR_WARNING);
+	zassert_equal(states[4], CAN_STATE_ERROR_ACTIVE, "the fifth replaced the newest");
+	zassert_equal(state_cnt[4].tx_err_cnt, 0, "with its own error counters");
+}
+
 #endif
