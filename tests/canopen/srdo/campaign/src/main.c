@@ -602,16 +602,15 @@ static bool first_safe_event(uint32_t first_ev, struct ev_rec *out)
  * A frame that arrived before @p deadline_us but reached the consumer's line after it (done_us
  * 0: not even handed over yet): the host, not the bus, let the consumer's timer run first.
  */
-static const struct log_rec *handed_over_late(const struct log_rec *log, int n,
-					      uint64_t deadline_us)
+static bool handed_over_late(const struct log_rec *log, int n, uint64_t deadline_us)
 {
 	for (int i = 0; i < n; i++) {
 		if (log[i].t_us <= deadline_us &&
 		    (log[i].done_us == 0U || log[i].done_us > deadline_us)) {
-			return &log[i];
+			return true;
 		}
 	}
-	return NULL;
+	return false;
 }
 
 enum outcome {
@@ -648,7 +647,6 @@ static enum outcome run_case(enum fault_class fc, uint8_t byte, uint8_t bit)
 	struct replay rp;
 	uint8_t have_n[FRAME_LEN], have_i[FRAME_LEN];
 	enum co_srdo_reason reason;
-	const struct log_rec *late;
 	uint64_t t_start, t_arm, t_seen, t_fault;
 	uint32_t cursor, first_ev, written, extra;
 	int state, n;
@@ -687,9 +685,8 @@ static enum outcome run_case(enum fault_class fc, uint8_t byte, uint8_t bit)
 		if (rp.good == 0U && rp.reason == fault.reason) {
 			DISTURBED("the first frames call for %s", reason_name(rp.reason));
 		}
-		late = handed_over_late(log, n, fault.time_us);
 		if ((fault.reason == CO_SRDO_R_SCT || fault.reason == CO_SRDO_R_SRVT) &&
-		    late != NULL) {
+		    handed_over_late(log, n, fault.time_us)) {
 			DISTURBED("a frame before the %s deadline reached the line after it",
 				  reason_name(fault.reason));
 		}
