@@ -715,8 +715,8 @@ int co_node_setup(struct co_node *node, const char *name, struct co_line *line,
 	    n_services > UINT8_MAX) {
 		return -EINVAL;
 	}
-	memset(node, 0, sizeof(*node));
-	k_mutex_init(&node->lock);
+	(void)memset(node, 0, sizeof(*node));
+	(void)k_mutex_init(&node->lock);
 	node->name = name;
 	node->node_id = node_id;
 	node->pending_node_id = node_id;

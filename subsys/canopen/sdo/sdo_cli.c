@@ -117,7 +117,7 @@ static int cli_send(struct co_sdo_cli *cli, const uint8_t d[CO_SDO_DLC])
 {
 	struct can_frame f;
 
-	memset(&f, 0, sizeof(f));
+	(void)memset(&f, 0, sizeof(f));
 	if ((cli->cob_tx & CO_SDO_COBID_FRAME) != 0U) {
 		f.id = cli->cob_tx & EFF_MASK;
 		f.flags = CAN_FRAME_IDE;
@@ -125,7 +125,7 @@ static int cli_send(struct co_sdo_cli *cli, const uint8_t d[CO_SDO_DLC])
 		f.id = cli->cob_tx & SFF_MASK;
 	}
 	f.dlc = CO_SDO_DLC;
-	memcpy(f.data, d, CO_SDO_DLC);
+	(void)memcpy(f.data, d, CO_SDO_DLC);
 	return co_node_send(cli->node, CO_ROUTE_ACTIVE, &f);
 }
 
@@ -223,7 +223,7 @@ static uint32_t dn_send_segment(struct co_sdo_cli *cli)
 						    CO_SDO_SEG_N_PUT(CO_SDO_SEG_SIZE - chunk) |
 						    (last ? CO_SDO_SEG_C : 0U));
 	if (chunk > 0U) {
-		memcpy(&d[1], &cli->dn_data[cli->offset], chunk);
+		(void)memcpy(&d[1], &cli->dn_data[cli->offset], chunk);
 	}
 	cli->pending = chunk;
 	cli->state = ST_DN_SEG;
@@ -297,7 +297,7 @@ static void blk_dn_send(struct co_sdo_cli *cli, uint64_t now)
 
 		d[0] = i | (last ? CO_SDO_BLK_SEG_C : 0U);
 		if (chunk > 0U) {
-			memcpy(&d[1], &cli->dn_data[o], chunk);
+			(void)memcpy(&d[1], &cli->dn_data[o], chunk);
 		}
 		err = co_node_tx_space(cli->node, CO_ROUTE_ACTIVE) > TX_RESERVE ? cli_send(cli, d)
 										: -ENOBUFS;
@@ -406,7 +406,7 @@ static uint32_t up_init_rsp(struct co_sdo_cli *cli, const uint8_t *d)
 		if (n > cli->len) {
 			return CO_SDO_AB_OUT_OF_MEM;
 		}
-		memcpy(cli->up_buf, &d[4], n);
+		(void)memcpy(cli->up_buf, &d[4], n);
 		cli->offset = n;
 		cli_finish(cli, CO_SDO_AB_NONE);
 		return CO_SDO_AB_NONE;
@@ -440,7 +440,7 @@ static uint32_t up_seg_rsp(struct co_sdo_cli *cli, const uint8_t *d)
 		return CO_SDO_AB_OUT_OF_MEM;
 	}
 	if (n > 0U) {
-		memcpy(&cli->up_buf[cli->offset], &d[1], n);
+		(void)memcpy(&cli->up_buf[cli->offset], &d[1], n);
 	}
 	cli->offset += n;
 	if (last) {
@@ -503,7 +503,7 @@ static uint32_t blk_up_segment(struct co_sdo_cli *cli, const uint8_t *d)
 	if (seqno == cli->seq + 1U) {
 		if (c) {
 			/* How much of it is data only the end request tells. */
-			memcpy(cli->last_seg, &d[1], CO_SDO_SEG_SIZE);
+			(void)memcpy(cli->last_seg, &d[1], CO_SDO_SEG_SIZE);
 			cli->blk_last = true;
 		} else {
 			if (cli->size_ind && cli->offset + CO_SDO_SEG_SIZE > cli->size) {
@@ -512,7 +512,7 @@ static uint32_t blk_up_segment(struct co_sdo_cli *cli, const uint8_t *d)
 			if (cli->offset + CO_SDO_SEG_SIZE > cli->len) {
 				return CO_SDO_AB_OUT_OF_MEM;
 			}
-			memcpy(&cli->up_buf[cli->offset], &d[1], CO_SDO_SEG_SIZE);
+			(void)memcpy(&cli->up_buf[cli->offset], &d[1], CO_SDO_SEG_SIZE);
 			if (cli->crc_on) {
 				cli->crc = crc16_itu_t(cli->crc, &d[1], CO_SDO_SEG_SIZE);
 			}
@@ -553,7 +553,7 @@ static uint32_t blk_up_end(struct co_sdo_cli *cli, const uint8_t *d)
 		return CO_SDO_AB_OUT_OF_MEM;
 	}
 	if (n > 0U) {
-		memcpy(&cli->up_buf[cli->offset], cli->last_seg, n);
+		(void)memcpy(&cli->up_buf[cli->offset], cli->last_seg, n);
 	}
 	if (cli->crc_on) {
 		cli->crc = crc16_itu_t(cli->crc, cli->last_seg, n);
@@ -653,6 +653,8 @@ static void cli_rx(struct co_rx *rx, const struct can_frame *frame, uint64_t now
 		cli_finish(cli, code);
 	} else if (running(cli)) {
 		cli_wait(cli, now_us);
+	} else {
+		/* The frame ended the transfer: cli_dispatch() already reported it. */
 	}
 }
 
@@ -818,7 +820,7 @@ int co_sdo_cli_init(struct co_sdo_cli *cli, struct co_node *node, uint8_t num)
 	if (cli == NULL || node == NULL || num >= CONFIG_CANOPEN_SDO_CLIENTS) {
 		return -EINVAL;
 	}
-	memset(cli, 0, sizeof(*cli));
+	(void)memset(cli, 0, sizeof(*cli));
 	cli->node = node;
 	cli->num = num;
 	cli->cob_tx = CO_SDO_COBID_INVALID;
@@ -1021,7 +1023,7 @@ int co_sdo_cli_download_req(struct co_sdo_cli *cli, uint16_t index, uint8_t sub,
 			d[0] = CO_SDO_B0(CO_SDO_CCS_DN_INIT,
 					 CO_SDO_INIT_E | CO_SDO_INIT_S |
 						 CO_SDO_INIT_N_PUT(CO_SDO_EXP_SIZE - len));
-			memcpy(&d[4], data, len);
+			(void)memcpy(&d[4], data, len);
 			cli->exp = true;
 			state = ST_DN_INIT;
 		} else {
@@ -1203,7 +1205,7 @@ int co_sdo_cli_download(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, con
 	if (err != 0) {
 		return err;
 	}
-	k_sem_init(&call.sem, 0, 1);
+	(void)k_sem_init(&call.sem, 0, 1);
 	/* Protocol timeout 0: CONFIG_CANOPEN_SDO_CLIENT_TIMEOUT per answer of the server. */
 	err = co_sdo_cli_download_req(cli, index, sub, data, len, mode, 0U, sync_con, &call);
 	if (err != 0) {
@@ -1226,7 +1228,7 @@ int co_sdo_cli_upload(struct co_sdo_cli *cli, uint16_t index, uint8_t sub, void 
 	if (err != 0) {
 		return err;
 	}
-	k_sem_init(&call.sem, 0, 1);
+	(void)k_sem_init(&call.sem, 0, 1);
 	err = co_sdo_cli_upload_req(cli, index, sub, buf, cap, mode, 0U, sync_con, &call);
 	if (err != 0) {
 		return err;
