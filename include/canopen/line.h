@@ -151,7 +151,10 @@ struct co_rx {
 	void *user_data;
 
 	/** @cond INTERNAL_HIDDEN */
+#if !defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	/* The next receiver of the same 11-bit id, or of the masked and 29-bit ones. */
 	struct co_rx *next;
+#endif
 	struct co_line *line;
 	/* The line's copy of (id, ext) and mask, for masked and 29-bit receivers: written when
 	 * the receiver joins a line, read by lookups that take no lock (line.c).
@@ -241,7 +244,14 @@ struct co_line_rx_msg {
 
 struct co_line {
 	const char *name;
-#if defined(CONFIG_CANOPEN_LINE_RX_INDEX)
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	/* Receive table: the n_rx receivers, the n_exact exact 11-bit ones first, each part in
+	 * registration order (the order in which a frame reaches them).
+	 */
+	struct co_rx *rx_tab[CONFIG_CANOPEN_LINE_RX_SLOTS];
+	uint8_t n_rx;
+	uint8_t n_exact;
+#elif defined(CONFIG_CANOPEN_LINE_RX_INDEX)
 	/* Receive table: sff[id] is 1 + slot of the first receiver of 11-bit id, 0 for none. */
 	uint8_t sff[CO_LINE_SFF_IDS];
 #else
@@ -249,10 +259,12 @@ struct co_line {
 	uint16_t slot_ids[CONFIG_CANOPEN_LINE_RX_SLOTS];
 	uint8_t n_slots;
 #endif
+#if !defined(CONFIG_CANOPEN_LINE_RX_FLAT)
 	/* Heads of the chains of receivers of one 11-bit id. */
 	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
 	/* 29-bit and masked receivers, searched in order. */
 	struct co_rx *others;
+#endif
 	/*
 	 * Sequence count of the receive table: odd while a writer (holding lock) changes it.
 	 * Lookups read the table without the lock and keep their result only when the count
@@ -445,13 +457,16 @@ static inline void co_rx_init(struct co_rx *rx, uint32_t id, co_rx_handler_t han
  * @brief Register a receiver on a line.
  *
  * Fill @p rx (id, mask, ext, handler, lock, user_data) first. Several receivers may share one
- * COB-ID; each gets every matching frame. An exact 11-bit receiver (mask 7FFh) is found in
- * constant time; masked and 29-bit receivers are searched in a short list.
+ * COB-ID; each gets every matching frame, exact 11-bit receivers (mask 7FFh) first, each kind
+ * in registration order. An exact 11-bit receiver is found by its id; masked and 29-bit
+ * receivers are searched in a short list. With CONFIG_CANOPEN_LINE_RX_FLAT a frame is compared
+ * with every receiver of the line.
  *
  * @retval 0 Registered.
  * @retval -EALREADY @p rx is already registered on a line.
  * @retval -EINVAL The id does not fit 11 (or 29) bits.
- * @retval -ENOSPC All CONFIG_CANOPEN_LINE_RX_SLOTS distinct 11-bit ids are in use.
+ * @retval -ENOSPC All CONFIG_CANOPEN_LINE_RX_SLOTS distinct 11-bit ids are in use (with
+ *         CONFIG_CANOPEN_LINE_RX_FLAT: that many receivers are registered).
  */
 int co_rx_register(struct co_line *line, struct co_rx *rx);
 

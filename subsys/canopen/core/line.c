@@ -287,7 +287,64 @@ static void tbl_change_end(struct co_line *line)
  * and searched (binary search over CONFIG_CANOPEN_LINE_RX_SLOTS at most). Writers hold the
  * table lock; readers take none (acquire loads, see above).
  */
-#if defined(CONFIG_CANOPEN_LINE_RX_INDEX)
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+
+/*
+ * One table of receivers (CONFIG_CANOPEN_LINE_RX_FLAT): the n_exact exact 11-bit ones, then the
+ * masked and 29-bit ones, each part in registration order, so a frame meets its receivers in
+ * the order the chains below give. Every receiver carries its match key. Writers shift the
+ * entries under the table lock; readers take a snapshot of the count and skip an entry a
+ * writer has just cleared.
+ */
+
+/* Position of @p rx in the table, or -1 (writers). */
+static int rx_pos(const struct co_line *line, const struct co_rx *rx)
+{
+	for (int i = 0; i < line->n_rx; i++) {
+		if (line->rx_tab[i] == rx) {
+			return i;
+		}
+	}
+	return -1;
+}
+
+/* Link a receiver; table lock held, between tbl_change_begin() and tbl_change_end(). */
+static int rx_tab_link(struct co_line *line, struct co_rx *rx)
+{
+	int n = line->n_rx;
+	bool direct = rx_is_direct(rx);
+	int p = direct ? line->n_exact : n;
+
+	if (n >= CONFIG_CANOPEN_LINE_RX_SLOTS) {
+		return -ENOSPC;
+	}
+	for (int i = n; i > p; i--) {
+		ST_REL(&line->rx_tab[i], line->rx_tab[i - 1]);
+	}
+	ST_REL(&line->rx_tab[p], rx);
+	if (direct) {
+		line->n_exact++;
+	}
+	ST_REL(&line->n_rx, (uint8_t)(n + 1));
+	return 0;
+}
+
+/* Unlink a receiver; as rx_tab_link(). */
+static void rx_tab_unlink(struct co_line *line, int pos)
+{
+	int n = line->n_rx;
+
+	for (int i = pos; i + 1 < n; i++) {
+		ST_REL(&line->rx_tab[i], line->rx_tab[i + 1]);
+	}
+	ST_REL(&line->rx_tab[n - 1], NULL);
+	if (pos < line->n_exact) {
+		line->n_exact--;
+	}
+	ST_REL(&line->n_rx, (uint8_t)(n - 1));
+}
+
+#elif defined(CONFIG_CANOPEN_LINE_RX_INDEX)
 
 static int slot_of(const struct co_line *line, uint32_t id)
 {
@@ -412,7 +469,7 @@ static ALWAYS_INLINE struct co_rx *slot_head(const struct co_line *line, uint32_
 	return lo < n && LD_ACQ(&line->slot_ids[lo]) == id ? LD_ACQ(&line->slots[lo]) : NULL;
 }
 
-#endif /* CONFIG_CANOPEN_LINE_RX_INDEX */
+#endif /* CONFIG_CANOPEN_LINE_RX_FLAT, CONFIG_CANOPEN_LINE_RX_INDEX */
 
 /*
  * rx->line changes under the table lock but is read without it: by the dispatcher, which has
@@ -432,6 +489,13 @@ static inline void rx_line_set(struct co_rx *rx, struct co_line *line)
 /* Link a receiver; table lock held, between tbl_change_begin() and tbl_change_end(). */
 static int rx_link(struct co_line *line, struct co_rx *rx)
 {
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	ST_REL(&rx->key_id, rx->id | (rx->ext ? KEY_EXT : 0U));
+	ST_REL(&rx->key_mask, rx->mask | KEY_EXT);
+	if (rx_tab_link(line, rx) < 0) {
+		return -ENOSPC;
+	}
+#else
 	ST_REL(&rx->next, NULL);
 	if (rx_is_direct(rx)) {
 		uint32_t id = rx->id & SFF_MASK;
@@ -460,6 +524,7 @@ static int rx_link(struct co_line *line, struct co_rx *rx)
 		}
 		ST_REL(pp, rx);
 	}
+#endif
 	rx_line_set(rx, line);
 	return 0;
 }
@@ -467,6 +532,14 @@ static int rx_link(struct co_line *line, struct co_rx *rx)
 /* Unlink a receiver; as rx_link(). */
 static void rx_unlink(struct co_line *line, struct co_rx *rx)
 {
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	int pos = rx_pos(line, rx);
+
+	if (pos < 0) {
+		return;
+	}
+	rx_tab_unlink(line, pos);
+#else
 	struct co_rx **pp;
 
 	if (rx_is_direct(rx)) {
@@ -496,6 +569,7 @@ static void rx_unlink(struct co_line *line, struct co_rx *rx)
 		}
 	}
 	ST_REL(&rx->next, NULL);
+#endif
 	rx_line_set(rx, NULL);
 }
 
@@ -604,6 +678,26 @@ static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can
 	struct co_rx *rx;
 	int m = 0;
 
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	uint32_t key = frame->id | (ext ? KEY_EXT : 0U);
+	int n = LD_ACQ(&line->n_rx);
+
+	/* The table is bounded: no walk to cut short. */
+	ARG_UNUSED(budget);
+	if (n > CONFIG_CANOPEN_LINE_RX_SLOTS) {
+		n = CONFIG_CANOPEN_LINE_RX_SLOTS;
+	}
+	for (int i = 0; i < n; i++) {
+		rx = LD_ACQ(&line->rx_tab[i]);
+		if (rx != NULL && ((key ^ LD_ACQ(&rx->key_id)) & LD_ACQ(&rx->key_mask)) == 0U &&
+		    rx_selected(rx, lock, only)) {
+			if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
+				batch[m] = rx;
+			}
+			m++;
+		}
+	}
+#else
 	if (!ext) {
 		for (rx = slot_head(line, frame->id & SFF_MASK); rx != NULL;
 		     rx = LD_ACQ(&rx->next)) {
@@ -635,6 +729,7 @@ static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can
 			}
 		}
 	}
+#endif
 	return m;
 }
 
@@ -1108,6 +1203,16 @@ int co_line_attach(struct co_line *line, struct co_line_member *m, const struct 
 /* Drop every receiver and timer of one owner (a node leaving the line). */
 static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 {
+#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+	/* From the top: rx_unlink() moves the entries above down. */
+	for (int i = line->n_rx - 1; i >= 0; i--) {
+		struct co_rx *rx = line->rx_tab[i];
+
+		if (rx->lock == lock) {
+			rx_unlink(line, rx);
+		}
+	}
+#else
 	/*
 	 * The used slots hold every exact 11-bit receiver; rx_unlink() frees emptied ones (and
 	 * without the index moves the slots above down: hence from the top).
@@ -1126,6 +1231,7 @@ static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 			rx_unlink(line, rx);
 		}
 	}
+#endif
 	struct co_timer *t;
 	struct co_timer *tn;
 
