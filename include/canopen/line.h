@@ -218,12 +218,16 @@ struct co_line_stats {
 };
 
 /** @cond INTERNAL_HIDDEN */
-enum co_line_msg_kind {
-	CO_LINE_MSG_FRAME,
-	CO_LINE_MSG_WAKE,
-	/* A frame sent by a node of this line, for the line's other nodes. */
-	CO_LINE_MSG_LOCAL,
-};
+/*
+ * The kind of a queued message, in the two high bits of its frame's dlc, which a frame never
+ * sets (a DLC is 4 bits on the bus; a driver refuses a larger one to send): a field of its own
+ * would make the message 4 bytes longer. A frame from the bus has neither.
+ */
+#define CO_LINE_MSG_FRAME 0x00U
+#define CO_LINE_MSG_WAKE  0x80U
+/* A frame sent by a node of this line, for the line's other nodes. */
+#define CO_LINE_MSG_LOCAL 0x40U
+#define CO_LINE_MSG_KINDS (CO_LINE_MSG_WAKE | CO_LINE_MSG_LOCAL)
 
 struct co_line_rx_msg {
 #if defined(CONFIG_CANOPEN_LINE_SHARED)
@@ -232,14 +236,14 @@ struct co_line_rx_msg {
 	 */
 	const struct k_mutex *origin;
 #endif
+	/* Its dlc carries the kind (CO_LINE_MSG_KINDS). */
 	struct can_frame frame;
 	/*
 	 * Low 32 bits of the reception time [µs]: a message waits far less than the 35 minutes
-	 * that half of them span, and the reader extends them from its own time. With a 64-bit
-	 * time the message would be 8-aligned: 32 instead of 24 bytes (28 on a shared line).
+	 * that half of them span, and the reader extends them from its own time. A message is 20
+	 * bytes on a 32-bit target (24 on a shared line); a 64-bit time would make it 24 (32).
 	 */
 	uint32_t time_lo;
-	uint8_t kind;
 };
 
 struct co_line {

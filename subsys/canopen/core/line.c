@@ -1283,8 +1283,10 @@ local_deliver(struct co_line *line, const struct can_frame *frame, const struct 
 		.frame = *frame,
 		.time_lo = (uint32_t)co_line_time(line),
 		.origin = origin,
-		.kind = CO_LINE_MSG_LOCAL,
 	};
+
+	/* The frame went to the driver or the sink: its dlc has none of the kind's bits. */
+	msg.frame.dlc |= CO_LINE_MSG_LOCAL;
 
 	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
 		atomic_inc(&line->rx_overruns);
@@ -1321,7 +1323,8 @@ void co_line_local_drain(struct co_line *line)
 		if (k_msgq_get(&line->rxq, &msg, K_NO_WAIT) != 0) {
 			break;
 		}
-		if (msg.kind == CO_LINE_MSG_LOCAL) {
+		if ((msg.frame.dlc & CO_LINE_MSG_KINDS) == CO_LINE_MSG_LOCAL) {
+			msg.frame.dlc &= (uint8_t)~CO_LINE_MSG_LOCAL;
 			co_line_dispatch(line, &msg.frame,
 					 co_line_msg_time(&msg, co_line_time(line)), msg.origin);
 		}

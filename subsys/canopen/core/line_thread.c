@@ -43,7 +43,7 @@ struct co_line *co_line_current(void)
 
 void co_line_wake(struct co_line *line)
 {
-	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
+	struct co_line_rx_msg msg = {.frame.dlc = CO_LINE_MSG_WAKE};
 
 	if (co_line_is_sim(line) || !atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
 		return;
@@ -93,9 +93,7 @@ static void line_rx_cb(const struct device *dev, struct can_frame *frame, void *
 	struct co_line_rx_msg msg = {
 		.frame = *frame,
 		.time_lo = (uint32_t)line_rx_time(frame),
-		.kind = CO_LINE_MSG_FRAME,
 	};
-
 	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
 		/* Counted here; reported by the thread, which is busy draining the queue. */
 		atomic_inc(&line->rx_overruns);
@@ -187,10 +185,13 @@ static void line_drain(struct co_line *line, struct co_line_rx_msg *msg)
 	uint64_t ref = co_line_now();
 
 	do {
-		if (msg->kind == CO_LINE_MSG_FRAME) {
+		unsigned int kind = msg->frame.dlc & CO_LINE_MSG_KINDS;
+
+		if (kind == CO_LINE_MSG_FRAME) {
 			co_line_rx(line, &msg->frame, co_line_msg_time(msg, ref));
 #if defined(CONFIG_CANOPEN_LINE_SHARED)
-		} else if (msg->kind == CO_LINE_MSG_LOCAL) {
+		} else if (kind == CO_LINE_MSG_LOCAL) {
+			msg->frame.dlc &= (uint8_t)~CO_LINE_MSG_LOCAL;
 			co_line_dispatch(line, &msg->frame, co_line_msg_time(msg, ref),
 					 msg->origin);
 #endif
@@ -299,7 +300,7 @@ static bool line_tx_settled(struct co_line *line, int ms)
 
 int co_line_stop(struct co_line *line)
 {
-	struct co_line_rx_msg msg = {.kind = CO_LINE_MSG_WAKE};
+	struct co_line_rx_msg msg = {.frame.dlc = CO_LINE_MSG_WAKE};
 
 	if (!atomic_test_bit(&line->flags, CO_LINE_F_RUNNING)) {
 		/* Stopped, but a TX completion was still due: ask again. */

@@ -41,8 +41,12 @@ static void record(int tag, uint64_t now)
 	fx.log[fx.log_len++] = tag;
 }
 
+/* The last frame a receiver got. */
+static struct can_frame last_rx;
+
 static void rx_handler(struct co_rx *rx, const struct can_frame *frame, uint64_t now_us)
 {
+	last_rx = *frame;
 	record((int)(intptr_t)rx->user_data, now_us);
 }
 
@@ -742,6 +746,16 @@ ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 	zassert_equal(fx.log_len, 1);
 	zassert_equal(fx.log[0], 2, "only the other node gets it");
 	zassert_equal(fx.log_time[0], 10, "reception time = send time");
+	zassert_mem_equal(&last_rx, &f, sizeof(f), "the frame as sent (dlc, flags, data)");
+
+	/* Through the line's queue as the sent frame: dlc 8 and the RTR flag come out as they went.
+	 */
+	f = std_frame(0x701, 8);
+	f.flags = CAN_FRAME_RTR;
+	zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
+	co_line_process(&fx.line, 30);
+	zassert_equal(fx.log_len, 2);
+	zassert_mem_equal(&last_rx, &f, sizeof(f));
 
 	struct co_line_stats st;
 
