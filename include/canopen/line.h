@@ -263,6 +263,11 @@ struct co_line {
 	uint16_t slot_ids[CONFIG_CANOPEN_LINE_RX_SLOTS];
 	uint8_t n_slots;
 #endif
+	/*
+	 * Nodes attached; from two on, frames a node sends reach the others (local delivery).
+	 * Here, beside the table's counts, rather than in a padded word of its own.
+	 */
+	uint8_t n_nodes;
 #if !defined(CONFIG_CANOPEN_LINE_RX_FLAT)
 	/* Heads of the chains of receivers of one 11-bit id. */
 	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
@@ -305,16 +310,14 @@ struct co_line {
 	void *event_user_data;
 	/* Listeners of the nodes on the line, in registration order. */
 	struct co_line_listener *listeners;
-	/* Send-side events waiting for the line thread's listeners. */
-	atomic_t tx_overflow_pending;
+	/* A send-side TX error waiting for the line thread's listeners (an overflow: a flag). */
 	atomic_t tx_error_pending;
+	/* rx_overruns is counted with atomic operations (driver callbacks), the rest as noted. */
 	struct co_line_stats stats;
 #if defined(CONFIG_CANOPEN_LINE_SIM)
 	/* Simulation mode: the time of the last co_line_rx()/co_line_process(). */
 	uint64_t sim_now;
 #endif
-	/* Nodes attached; from two on, frames a node sends reach the others (local delivery). */
-	uint8_t n_nodes;
 	struct co_line_member *members;
 
 	/* Received frames for the thread; in simulation, frames for local delivery only. */
@@ -324,13 +327,15 @@ struct co_line {
 	char rxq_buf[CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE * sizeof(struct co_line_rx_msg)];
 	k_tid_t tid;
 	int filter_std;
-	int filter_ext;
-	/* After the three words above: in the 32-bit footprint build, on its 16-byte alignment. */
+	/*
+	 * After the two words above: in the 32-bit footprint build, on its 16-byte alignment, and
+	 * the four words after it end the line there too (no padding before or after it).
+	 */
 	struct k_thread thread;
+	int filter_ext;
 	atomic_t flags;
 	atomic_t can_state;
 	atomic_t tx_async_err;
-	atomic_t rx_overruns;
 };
 /** @endcond */
 

@@ -171,7 +171,7 @@ void co_line_report_from_send(struct co_line *line, enum co_line_event event, in
 	 * deadlock against the line thread, so the listeners hear of it from the line thread.
 	 */
 	if (event == CO_LINE_EV_TX_OVERFLOW) {
-		atomic_inc(&line->tx_overflow_pending);
+		atomic_set_bit(&line->flags, CO_LINE_F_TX_OVERFLOW);
 	} else {
 		atomic_set(&line->tx_error_pending, arg != 0 ? arg : -EIO);
 	}
@@ -183,7 +183,7 @@ void co_line_report_deferred(struct co_line *line)
 	atomic_val_t err;
 
 	/* Several overflows since the last look are one event for the listeners. */
-	if (atomic_set(&line->tx_overflow_pending, 0) != 0) {
+	if (atomic_test_and_clear_bit(&line->flags, CO_LINE_F_TX_OVERFLOW)) {
 		report_listeners(line, CO_LINE_EV_TX_OVERFLOW, 0);
 	}
 	err = atomic_set(&line->tx_error_pending, 0);
@@ -1289,8 +1289,7 @@ local_deliver(struct co_line *line, const struct can_frame *frame, const struct 
 	msg.frame.dlc |= CO_LINE_MSG_LOCAL;
 
 	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
-		atomic_inc(&line->rx_overruns);
-		atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+		co_line_rx_overrun(line);
 	}
 }
 
@@ -1384,5 +1383,5 @@ void co_line_get_stats(struct co_line *line, struct co_line_stats *stats)
 	stats->rx_frames = __atomic_load_n(&line->stats.rx_frames, __ATOMIC_RELAXED);
 	stats->rx_unhandled = __atomic_load_n(&line->stats.rx_unhandled, __ATOMIC_RELAXED);
 	stats->rx_fanout_drops = __atomic_load_n(&line->stats.rx_fanout_drops, __ATOMIC_RELAXED);
-	stats->rx_overruns = (uint32_t)atomic_get(&line->rx_overruns);
+	stats->rx_overruns = __atomic_load_n(&line->stats.rx_overruns, __ATOMIC_RELAXED);
 }

@@ -25,6 +25,15 @@
  * followed before the thread ran; bus-off must still be reported).
  */
 #define CO_LINE_F_BUS_OFF      6
+/* The TX queue overflowed since the line thread last told the listeners (several are one). */
+#define CO_LINE_F_TX_OVERFLOW  7
+
+/* A frame lost to a full RX queue: counted, and reported by the line thread. */
+static inline void co_line_rx_overrun(struct co_line *line)
+{
+	(void)__atomic_fetch_add(&line->stats.rx_overruns, 1U, __ATOMIC_RELAXED);
+	atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+}
 
 /*
  * A simulated line (co_line_init_sim()): no CAN device, time driven by the caller. Without

@@ -96,8 +96,7 @@ static void line_rx_cb(const struct device *dev, struct can_frame *frame, void *
 	};
 	if (k_msgq_put(&line->rxq, &msg, K_NO_WAIT) != 0) {
 		/* Counted here; reported by the thread, which is busy draining the queue. */
-		atomic_inc(&line->rx_overruns);
-		atomic_set_bit(&line->flags, CO_LINE_F_RX_OVERRUN);
+		co_line_rx_overrun(line);
 	}
 }
 

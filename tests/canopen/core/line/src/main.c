@@ -27,6 +27,8 @@ struct fixture {
 	struct can_frame sent[MAX_LOG];
 	int sent_len;
 	int sink_result;
+	/* Take frames without recording them (more than MAX_LOG). */
+	bool sink_discard;
 	int events[MAX_LOG];
 	int event_args[MAX_LOG];
 	int event_len;
@@ -54,6 +56,9 @@ static int sink(struct co_line *line, const struct can_frame *frame, void *user_
 {
 	if (fx.sink_result != 0) {
 		return fx.sink_result;
+	}
+	if (fx.sink_discard) {
+		return 0;
 	}
 	zassert_true(fx.sent_len < MAX_LOG);
 	fx.sent[fx.sent_len++] = *frame;
@@ -761,6 +766,33 @@ ZTEST(co_line, test_frames_of_one_node_reach_the_other_nodes_of_the_line)
 
 	co_line_get_stats(&fx.line, &st);
 	zassert_equal(st.rx_frames, 0, "local frames are not counted as received from the bus");
+}
+
+/* Local frames that find the line's RX queue full are lost and counted as overruns. */
+ZTEST(co_line, test_local_frames_beyond_the_rx_queue_are_counted_as_overruns)
+{
+	struct k_mutex node_a, node_b;
+	struct co_line_member ma, mb;
+	struct can_frame f = std_frame(0x701, 1);
+	struct co_line_stats st;
+
+	if (!IS_ENABLED(CONFIG_CANOPEN_LINE_SHARED)) {
+		ztest_test_skip();
+	}
+	k_mutex_init(&node_a);
+	k_mutex_init(&node_b);
+	zassert_ok(co_line_attach(&fx.line, &ma, &node_a));
+	zassert_ok(co_line_attach(&fx.line, &mb, &node_b));
+	fx.sink_discard = true;
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE + 2; i++) {
+		zassert_ok(co_line_send_from(&fx.line, &f, &node_a));
+	}
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.rx_overruns, 2, "the two frames the queue had no room for");
+	zassert_equal(st.tx_frames, CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE + 2, "all went to the bus");
+	co_line_process(&fx.line, 0);
+	co_line_detach(&fx.line, &mb);
+	co_line_detach(&fx.line, &ma);
 }
 
 /*
