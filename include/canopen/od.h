@@ -657,12 +657,26 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 #define CO_OD_COVER_R_FAST     0x1000U /* a PDO/SRDO read: copy */
 /** @endcond */
 
-/** @brief Hook coverage of one object; zero-initialise, then leave to the accessors. */
+/** @cond INTERNAL_HIDDEN */
+/* A position in the hook table: one byte when the table has fewer than 256 entries. */
+#if CO_OD_HOOKS_MAX < 256
+typedef uint8_t co_od_hook_pos_t;
+#else
+typedef uint16_t co_od_hook_pos_t;
+#endif
+/** @endcond */
+
+/**
+ * @brief Hook coverage of one object; zero-initialise, then leave to the accessors.
+ *
+ * 8 bytes with fewer than 256 hooks. The generation stays a full co_od.hook_gen: a shorter
+ * one would wrap and make a stale cover look fresh.
+ */
 struct co_od_cover {
-	uint32_t gen;   /**< co_od.hook_gen when made (never 0: a zeroed cover is stale) */
-	uint16_t first; /**< position of the first hook covering the object */
-	uint16_t end;   /**< one past the last hook covering it */
-	uint16_t flags; /**< CO_OD_COVER_* */
+	uint32_t gen;           /**< co_od.hook_gen when made (never 0: a zeroed cover is stale) */
+	co_od_hook_pos_t first; /**< position of the first hook covering the object */
+	co_od_hook_pos_t end;   /**< one past the last hook covering it (first = end: none) */
+	uint16_t flags;         /**< CO_OD_COVER_* */
 };
 
 /** @cond INTERNAL_HIDDEN */

@@ -1277,26 +1277,26 @@ cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_c
 {
 	uint16_t index = info->index;
 	uint16_t flags = CO_OD_COVER_MADE | CO_OD_COVER_EXACT;
+	uint16_t first = UINT16_MAX;
+	uint16_t end = 0U;
 
-	cover->first = UINT16_MAX;
-	cover->end = 0U;
 	for (uint16_t i = hooks_start(od, index);
 	     i < od->n_hooks && od->hooks[i].index_first <= index; i++) {
 		const struct co_od_hook_ent *h = &od->hooks[i];
 
 		if (!hook_covers(h, index, info->sub)) {
 			/* A hook between two covering ones: the range is not exact. */
-			if (cover->first != UINT16_MAX) {
+			if (first != UINT16_MAX) {
 				flags &= (uint16_t)~CO_OD_COVER_EXACT;
 			}
 			continue;
 		}
-		if (cover->first == UINT16_MAX) {
-			cover->first = i;
-		} else if (cover->end != i) {
+		if (first == UINT16_MAX) {
+			first = i;
+		} else if (end != i) {
 			flags &= (uint16_t)~CO_OD_COVER_EXACT;
 		}
-		cover->end = i + 1U;
+		end = i + 1U;
 		if (h->kind == CO_OD_HOOK_ENT_READ_CHECK) {
 			flags |= CO_OD_COVER_READ_CHECK;
 		} else {
@@ -1325,9 +1325,15 @@ cover_make(const struct co_od *od, const struct co_od_info *info, struct co_od_c
 	/* One hook, a notify one: the pass is one call, nothing can follow it. */
 	if ((flags & (CO_OD_COVER_EXACT | CO_OD_COVER_NOTIFY)) ==
 		    (CO_OD_COVER_EXACT | CO_OD_COVER_NOTIFY) &&
-	    cover->end == cover->first + 1U) {
+	    end == first + 1U) {
 		flags |= CO_OD_COVER_NOTIFY1;
 	}
+	/* No covering hook: an empty range (the positions fit co_od_hook_pos_t). */
+	if (first == UINT16_MAX) {
+		first = 0U;
+	}
+	cover->first = (co_od_hook_pos_t)first;
+	cover->end = (co_od_hook_pos_t)end;
 	/* What the inline accessors of od.h do alone: copy, then at most one notify call. */
 	if ((flags & COVER_W_MASK) == COVER_W_COPY &&
 	    ((flags & CO_OD_COVER_NOTIFY) == 0U || (flags & CO_OD_COVER_NOTIFY1) != 0U)) {

@@ -264,4 +264,49 @@ ZTEST(od_cached, test_one_notify_hook_that_changes_the_table)
 	zassert_equal(co_od_hook_unregister(&fx.od, &grow_calls), 1);
 }
 
+/* The cover is 8 bytes while hook positions fit a byte, the generation a full word. */
+ZTEST(od_cached, test_cover_layout)
+{
+	zassert_equal(sizeof(((struct co_od_cover *)NULL)->gen), sizeof(uint32_t));
+	if (CONFIG_CANOPEN_OD_HOOKS_MAX < 256) {
+		zassert_equal(sizeof(struct co_od_cover), 8U);
+	} else {
+		zassert_equal(sizeof(((struct co_od_cover *)NULL)->first), sizeof(uint16_t));
+	}
+}
+
+static void filler_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+}
+
+/*
+ * A hook behind every other entry of a full table (past position 255 when the table holds
+ * 256 or more) is found by the cover: its validate and notify hooks run on cached writes.
+ */
+ZTEST(od_cached, test_cover_finds_the_last_hook_of_a_full_table)
+{
+	static int filler;
+	struct probe p = {0};
+	struct co_od_cover cover = {0};
+
+	for (int i = 0; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 1; i++) {
+		const struct co_od_hook f = {0x1000, 0x1000, 0, 0, NULL, filler_notify, &filler};
+
+		zassert_ok(co_od_hook_register(&fx.od, &f));
+	}
+	const struct co_od_hook h = {0x6000, 0x6000, 7, 7, p_validate, p_notify, &p};
+
+	zassert_ok(co_od_hook_register(&fx.od, &h));
+	zassert_equal(fx.od.n_hooks, CONFIG_CANOPEN_OD_HOOKS_MAX);
+	write_u32_cached(&cover, 5);
+	write_u32_cached(&cover, 6);
+	if (IS_ENABLED(CONFIG_CANOPEN_OD_COVER)) {
+		zassert_equal(cover.first, CONFIG_CANOPEN_OD_HOOKS_MAX - 1);
+	}
+	zassert_equal(p.validated, 2);
+	zassert_equal(p.notified, 2);
+	zassert_equal(co_od_hook_unregister(&fx.od, &p), 1);
+	zassert_equal(co_od_hook_unregister(&fx.od, &filler), CONFIG_CANOPEN_OD_HOOKS_MAX - 1);
+}
+
 ZTEST_SUITE(od_cached, NULL, NULL, fx_before, NULL, NULL);
