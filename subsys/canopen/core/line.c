@@ -578,25 +578,6 @@ static bool id_fits(const struct co_rx *rx, uint32_t id)
 	return (id & ~(rx->ext ? EFF_MASK : SFF_MASK)) == 0U;
 }
 
-int co_rx_register(struct co_line *line, struct co_rx *rx)
-{
-	int err;
-
-	if (!id_fits(rx, rx->id)) {
-		return -EINVAL;
-	}
-	k_mutex_lock(&line->lock, K_FOREVER);
-	if (rx->line != NULL) {
-		err = -EALREADY;
-	} else {
-		tbl_change_begin(line);
-		err = rx_link(line, rx);
-		tbl_change_end(line);
-	}
-	k_mutex_unlock(&line->lock);
-	return err;
-}
-
 void co_rx_unregister(struct co_rx *rx)
 {
 	struct co_line *line = rx_line_get(rx);
@@ -613,31 +594,45 @@ void co_rx_unregister(struct co_rx *rx)
 	k_mutex_unlock(&line->lock);
 }
 
-int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id)
+/*
+ * Register @p rx with @p id, or (@p move) move it there from wherever it is registered. A
+ * receiver on another line leaves that line's table under that line's lock; the two table
+ * locks are never held together.
+ */
+static int rx_place(struct co_line *line, struct co_rx *rx, uint32_t id, bool move)
 {
 	struct co_line *old;
-	int err;
+	int err = -EALREADY;
 
 	if (!id_fits(rx, id)) {
 		return -EINVAL;
 	}
-	/* A receiver on another line leaves that line's table under that line's lock; the two
-	 * table locks are never held together.
-	 */
 	old = rx_line_get(rx);
-	if (old != NULL && old != line) {
+	if (move && old != NULL && old != line) {
 		co_rx_unregister(rx);
 	}
 	k_mutex_lock(&line->lock, K_FOREVER);
-	tbl_change_begin(line);
-	if (rx->line != NULL) {
-		rx_unlink(line, rx);
+	if (move || rx->line == NULL) {
+		tbl_change_begin(line);
+		if (rx->line != NULL) {
+			rx_unlink(line, rx);
+		}
+		rx->id = id;
+		err = rx_link(line, rx);
+		tbl_change_end(line);
 	}
-	rx->id = id;
-	err = rx_link(line, rx);
-	tbl_change_end(line);
 	k_mutex_unlock(&line->lock);
 	return err;
+}
+
+int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id)
+{
+	return rx_place(line, rx, id, true);
+}
+
+int co_rx_register(struct co_line *line, struct co_rx *rx)
+{
+	return rx_place(line, rx, rx->id, false);
 }
 
 /*
@@ -1209,7 +1204,8 @@ static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 		struct co_rx *rx = line->rx_tab[i];
 
 		if (rx->lock == lock) {
-			rx_unlink(line, rx);
+			rx_tab_unlink(line, i);
+			rx_line_set(rx, NULL);
 		}
 	}
 #else
