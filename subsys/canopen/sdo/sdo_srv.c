@@ -105,12 +105,16 @@ static int srv_send(struct co_sdo_srv *srv, const uint8_t d[CO_SDO_DLC])
 	return co_node_send(srv->node, srv->route, &f);
 }
 
-/* Send a frame made of byte 0, the transfer's multiplexer and zeros. */
-static void srv_send_b0_mux(struct co_sdo_srv *srv, uint8_t b0)
+/*
+ * Send a frame made of byte 0, the transfer's multiplexer and @p v in bytes 4..7 (an abort
+ * code, a size, a block size or 0): one sender for every frame of that shape.
+ */
+static void srv_send_mux(struct co_sdo_srv *srv, uint8_t b0, uint32_t v)
 {
 	uint8_t r[CO_SDO_DLC] = {b0};
 
 	put_mux(r, srv->index, srv->sub);
+	sys_put_le32(v, &r[4]);
 	(void)srv_send(srv, r);
 }
 
@@ -148,13 +152,9 @@ static void srv_drop(struct co_sdo_srv *srv)
 
 static void srv_abort(struct co_sdo_srv *srv, uint32_t code)
 {
-	uint8_t r[CO_SDO_DLC] = {CO_SDO_B0(CO_SDO_CS_ABORT, 0U)};
-
-	put_mux(r, srv->index, srv->sub);
-	sys_put_le32(code, &r[4]);
 	LOG_DBG("SDO server %u: abort %04x:%02x %08x (%s)", srv->num, srv->index, srv->sub, code,
 		co_sdo_abort_str(code));
-	(void)srv_send(srv, r);
+	srv_send_mux(srv, CO_SDO_B0(CO_SDO_CS_ABORT, 0U), code);
 	srv->stats.aborts_sent++;
 	srv->stats.last_abort = code;
 	srv_end(srv);
@@ -251,7 +251,7 @@ static uint32_t dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 		if (code != CO_SDO_AB_NONE) {
 			return code;
 		}
-		srv_send_b0_mux(srv, CO_SDO_B0(CO_SDO_SCS_DN_INIT, 0U));
+		srv_send_mux(srv, CO_SDO_B0(CO_SDO_SCS_DN_INIT, 0U), 0U);
 		srv->stats.completed++;
 		return CO_SDO_AB_NONE;
 	}
@@ -267,21 +267,17 @@ static uint32_t dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 	srv->done = 0U;
 	srv->buf_len = 0U;
 	srv->toggle = 0U;
-	srv_send_b0_mux(srv, CO_SDO_B0(CO_SDO_SCS_DN_INIT, 0U));
+	srv_send_mux(srv, CO_SDO_B0(CO_SDO_SCS_DN_INIT, 0U), 0U);
 	return CO_SDO_AB_NONE;
 }
 
-static uint32_t dn_segment(struct co_sdo_srv *srv, const uint8_t *d)
+/* A download segment (toggle checked); its answer's byte 0 goes to r[0], without the toggle. */
+static uint32_t dn_segment(struct co_sdo_srv *srv, const uint8_t *d, uint8_t *r)
 {
-	uint8_t r[CO_SDO_DLC] = {0};
 	uint32_t len = CO_SDO_SEG_SIZE - CO_SDO_SEG_N(d[0]);
 	bool last = (d[0] & CO_SDO_SEG_C) != 0U;
-	uint8_t t = d[0] & CO_SDO_SEG_T;
 	uint32_t code;
 
-	if ((t != 0U) != (srv->toggle != 0U)) {
-		return CO_SDO_AB_TOGGLE;
-	}
 	if (!dn_fits(srv, len)) {
 		return CO_SDO_AB_DATA_LONG;
 	}
@@ -299,13 +295,7 @@ static uint32_t dn_segment(struct co_sdo_srv *srv, const uint8_t *d)
 			return code;
 		}
 	}
-	r[0] = CO_SDO_B0(CO_SDO_SCS_DN_SEG, t);
-	(void)srv_send(srv, r);
-	if (last) {
-		srv_complete(srv);
-	} else {
-		srv->toggle ^= 1U;
-	}
+	r[0] = CO_SDO_B0(CO_SDO_SCS_DN_SEG, 0U);
 	return CO_SDO_AB_NONE;
 }
 
@@ -369,25 +359,24 @@ static uint32_t up_open(struct co_sdo_srv *srv)
 /* Answer an (initiate or switched block) upload request with the normal upload protocol. */
 static uint32_t up_respond(struct co_sdo_srv *srv)
 {
-	uint8_t r[CO_SDO_DLC] = {0};
-
-	put_mux(r, srv->index, srv->sub);
 	if (srv->size >= 1U && srv->size <= CO_SDO_EXP_SIZE) {
-		r[0] = CO_SDO_B0(CO_SDO_SCS_UP_INIT,
-				 CO_SDO_INIT_E | CO_SDO_INIT_S |
-					 CO_SDO_INIT_N_PUT(CO_SDO_EXP_SIZE - srv->size));
-		(void)memcpy(&r[4], srv->buf, srv->size);
-		(void)srv_send(srv, r);
+		/* The value's bytes, the unused ones 0 (the buffer holds at least 7 bytes). */
+		uint32_t v = sys_get_le32(srv->buf) &
+			     (UINT32_MAX >> (8U * (CO_SDO_EXP_SIZE - srv->size)));
+
+		srv_send_mux(srv,
+			     CO_SDO_B0(CO_SDO_SCS_UP_INIT,
+				       CO_SDO_INIT_E | CO_SDO_INIT_S |
+					       CO_SDO_INIT_N_PUT(CO_SDO_EXP_SIZE - srv->size)),
+			     v);
 		srv_complete(srv);
 		return CO_SDO_AB_NONE;
 	}
 	/* Segmented, size indicated; an empty value is one empty last segment. */
-	r[0] = CO_SDO_B0(CO_SDO_SCS_UP_INIT, CO_SDO_INIT_S);
-	sys_put_le32(srv->size, &r[4]);
 	srv->state = ST_UP_SEG;
 	srv->offset = 0U;
 	srv->toggle = 0U;
-	(void)srv_send(srv, r);
+	srv_send_mux(srv, CO_SDO_B0(CO_SDO_SCS_UP_INIT, CO_SDO_INIT_S), srv->size);
 	return CO_SDO_AB_NONE;
 }
 
@@ -401,17 +390,13 @@ static uint32_t up_initiate(struct co_sdo_srv *srv)
 	return up_respond(srv);
 }
 
-static uint32_t up_segment(struct co_sdo_srv *srv, const uint8_t *d)
+/* The next upload segment (toggle checked) into r, its byte 0 without the toggle. */
+static uint32_t up_segment(struct co_sdo_srv *srv, uint8_t *r)
 {
-	uint8_t r[CO_SDO_DLC] = {0};
-	uint8_t t = d[0] & CO_SDO_SEG_T;
 	uint32_t len;
 	uint32_t code;
 	bool last;
 
-	if ((t != 0U) != (srv->toggle != 0U)) {
-		return CO_SDO_AB_TOGGLE;
-	}
 	len = MIN(CO_SDO_SEG_SIZE, srv->size - srv->offset);
 	code = up_fill(srv, srv->offset, len, false);
 	if (code != CO_SDO_AB_NONE) {
@@ -419,11 +404,37 @@ static uint32_t up_segment(struct co_sdo_srv *srv, const uint8_t *d)
 	}
 	last = srv->offset + len >= srv->size;
 	r[0] = CO_SDO_B0(CO_SDO_SCS_UP_SEG,
-			 t | CO_SDO_SEG_N_PUT(CO_SDO_SEG_SIZE - len) | (last ? CO_SDO_SEG_C : 0U));
+			 CO_SDO_SEG_N_PUT(CO_SDO_SEG_SIZE - len) | (last ? CO_SDO_SEG_C : 0U));
 	(void)memcpy(&r[1], &srv->buf[srv->offset - srv->buf_off], len);
 	srv->offset += len;
+	return CO_SDO_AB_NONE;
+}
+
+/*
+ * A frame of a segmented download or upload: the command and toggle checks, the answer with
+ * the toggle and the step to the next segment are the same both ways.
+ */
+static uint32_t seg_transfer(struct co_sdo_srv *srv, const uint8_t *d)
+{
+	uint8_t r[CO_SDO_DLC] = {0};
+	bool dn = srv->state == ST_DN_SEG;
+	uint8_t t = d[0] & CO_SDO_SEG_T;
+	uint32_t code;
+
+	if (CO_SDO_CS(d[0]) != (dn ? CO_SDO_CCS_DN_SEG : CO_SDO_CCS_UP_SEG)) {
+		return CO_SDO_AB_CMD;
+	}
+	if ((t != 0U) != (srv->toggle != 0U)) {
+		return CO_SDO_AB_TOGGLE;
+	}
+	code = dn ? dn_segment(srv, d, r) : up_segment(srv, r);
+	if (code != CO_SDO_AB_NONE) {
+		return code;
+	}
+	r[0] |= t;
 	(void)srv_send(srv, r);
-	if (last) {
+	/* The last segment: c is bit 0 of the request downloading, of the answer uploading. */
+	if ((((dn ? d[0] : r[0]) & CO_SDO_SEG_C) != 0U)) {
 		srv_complete(srv);
 	} else {
 		srv->toggle ^= 1U;
@@ -447,7 +458,6 @@ static void blk_dn_ack(struct co_sdo_srv *srv)
 
 static uint32_t blk_dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 {
-	uint8_t r[CO_SDO_DLC] = {0};
 	uint32_t code;
 
 	srv->crc_on = (d[0] & CO_SDO_BLK_CRC) != 0U;
@@ -471,11 +481,10 @@ static uint32_t blk_dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 	 * is used when both sides support it, and some clients (python-canopen) read the
 	 * server's bit alone.
 	 */
-	r[0] = CO_SDO_B0(CO_SDO_SCS_BLK_DN,
-			 (srv->crc_on ? CO_SDO_BLK_CRC : 0U) | CO_SDO_BLK_SUB_INIT);
-	put_mux(r, srv->index, srv->sub);
-	r[4] = srv->blksize;
-	(void)srv_send(srv, r);
+	srv_send_mux(srv,
+		     CO_SDO_B0(CO_SDO_SCS_BLK_DN,
+			       (srv->crc_on ? CO_SDO_BLK_CRC : 0U) | CO_SDO_BLK_SUB_INIT),
+		     srv->blksize);
 	return CO_SDO_AB_NONE;
 }
 
@@ -556,7 +565,7 @@ static uint32_t blk_dn_end(struct co_sdo_srv *srv, const uint8_t *d)
 	if (code != CO_SDO_AB_NONE) {
 		return code;
 	}
-	srv_send_b0_mux(srv, CO_SDO_B0(CO_SDO_SCS_BLK_DN, CO_SDO_BLK_SUB_END));
+	srv_send_mux(srv, CO_SDO_B0(CO_SDO_SCS_BLK_DN, CO_SDO_BLK_SUB_END), 0U);
 	srv_complete(srv);
 	return CO_SDO_AB_NONE;
 }
@@ -633,7 +642,6 @@ static uint32_t blk_up_send(struct co_sdo_srv *srv, uint64_t now)
 
 static uint32_t blk_up_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 {
-	uint8_t r[CO_SDO_DLC] = {0};
 	uint8_t blksize = d[4];
 	uint32_t code;
 
@@ -657,10 +665,10 @@ static uint32_t blk_up_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 	srv->offset = 0U;
 	srv->blksize = blksize;
 	/* The CRC bit only for a client that asked for it (see blk_dn_initiate()). */
-	r[0] = CO_SDO_B0(CO_SDO_SCS_BLK_UP, (srv->crc_on ? CO_SDO_BLK_CRC : 0U) | CO_SDO_BLK_S);
-	put_mux(r, srv->index, srv->sub);
-	sys_put_le32(srv->size, &r[4]);
-	(void)srv_send(srv, r);
+	srv_send_mux(
+		srv,
+		CO_SDO_B0(CO_SDO_SCS_BLK_UP, (srv->crc_on ? CO_SDO_BLK_CRC : 0U) | CO_SDO_BLK_S),
+		srv->size);
 	return CO_SDO_AB_NONE;
 }
 
@@ -746,7 +754,9 @@ static uint32_t srv_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 
 static uint32_t srv_dispatch(struct co_sdo_srv *srv, const uint8_t *d, uint64_t now)
 {
+#if defined(CONFIG_CANOPEN_SDO_BLOCK)
 	uint8_t cs = CO_SDO_CS(d[0]);
+#endif
 
 	/* A client abort (byte 0 = 80h, its reserved bits 0) ends the transfer without an
 	 * answer and is ignored in idle. 81h-9Fh are no aborts: in a block download sub-block
@@ -765,9 +775,8 @@ static uint32_t srv_dispatch(struct co_sdo_srv *srv, const uint8_t *d, uint64_t 
 	case ST_IDLE:
 		return srv_initiate(srv, d);
 	case ST_DN_SEG:
-		return cs == CO_SDO_CCS_DN_SEG ? dn_segment(srv, d) : CO_SDO_AB_CMD;
 	case ST_UP_SEG:
-		return cs == CO_SDO_CCS_UP_SEG ? up_segment(srv, d) : CO_SDO_AB_CMD;
+		return seg_transfer(srv, d);
 #if defined(CONFIG_CANOPEN_SDO_BLOCK)
 	case ST_BLK_DN_SUB:
 		/* Every frame is a segment here: byte 0 has no command specifier. */
