@@ -123,7 +123,11 @@ static bool is_download(uint8_t state)
 	return state == ST_DN_SEG || state == ST_BLK_DN_SUB || state == ST_BLK_DN_END;
 }
 
-/* End the transfer (whatever the reason) and go idle; a pending write is dropped. */
+/*
+ * End the transfer (whatever the reason) and go idle; a pending write is dropped. Every way
+ * back to idle passes here, so a download starts with an empty buffer; an upload's first
+ * read sets the window.
+ */
 static void srv_end(struct co_sdo_srv *srv)
 {
 	if (is_download(srv->state)) {
@@ -132,7 +136,6 @@ static void srv_end(struct co_sdo_srv *srv)
 	co_timer_stop(&srv->timer);
 	srv->state = ST_IDLE;
 	srv->buf_len = 0U;
-	srv->buf_off = 0U;
 }
 
 static void srv_complete(struct co_sdo_srv *srv)
@@ -265,7 +268,6 @@ static uint32_t dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 	srv->state = ST_DN_SEG;
 	srv->offset = 0U;
 	srv->done = 0U;
-	srv->buf_len = 0U;
 	srv->toggle = 0U;
 	srv_send_mux(srv, CO_SDO_B0(CO_SDO_SCS_DN_INIT, 0U), 0U);
 	return CO_SDO_AB_NONE;
@@ -351,8 +353,6 @@ static uint32_t up_open(struct co_sdo_srv *srv)
 		return code;
 	}
 	srv->size = co_od_length(srv_od(srv), &srv->xfer.info);
-	srv->buf_off = 0U;
-	srv->buf_len = 0U;
 	return up_fill(srv, 0U, srv->size, true);
 }
 
@@ -471,7 +471,6 @@ static uint32_t blk_dn_initiate(struct co_sdo_srv *srv, const uint8_t *d)
 	srv->state = ST_BLK_DN_SUB;
 	srv->offset = 0U;
 	srv->done = 0U;
-	srv->buf_len = 0U;
 	srv->crc = 0U;
 	srv->seq = 0U;
 	srv->blksize = BLKSIZE;
