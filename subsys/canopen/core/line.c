@@ -247,10 +247,10 @@ void co_line_listener_remove(struct co_line_listener *l)
  * Lookups take no lock. Changes (register, unregister, move, detach) are made under
  * line->lock, between two increments of line->rx_seq: odd while a change is under way. A
  * lookup reads rx_seq, walks the table and reads rx_seq again; it keeps what it found only
- * when both reads gave the same even count, else it looks again, and at the second miss (or
- * while a writer is at work) it looks under the lock. Every word a lookup reads (the index,
- * the slots, the chains, the match keys, rx_seq) is written with a release store and read
- * with an acquire load: a lookup that sees any part of a change also sees the odd count the
+ * when both reads gave the same even count, else (or while a writer is at work) it looks
+ * again under the lock. Every word a lookup reads (the index, the slots or the flat table,
+ * the chains, the match keys, rx_seq) is written with a release store and read with an
+ * acquire load: a lookup that sees any part of a change also sees the odd count the
  * change began with, so it cannot keep a half-made table (no fences needed, TSan sees
  * every pair). Receivers are never freed (they live in the services), so a lookup that
  * follows a pointer a writer has just unlinked reads valid memory, and throws the result
@@ -728,21 +728,18 @@ static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can
 	return m;
 }
 
-/* The lookup missed a change of the table: once more without the lock, then under it. */
+/*
+ * The lookup met a change of the table: once more under the lock, which waits for the change
+ * to end (the table changes at registrations and COB-ID writes, rarely enough that a second
+ * try without the lock would not pay for its code).
+ */
 static __attribute__((noinline)) int rx_collect_again(struct co_line *line,
 						      const struct can_frame *frame,
 						      const struct k_mutex *lock, bool only,
 						      struct co_rx **batch)
 {
-	uint32_t seq = LD_ACQ(&line->rx_seq);
 	int m;
 
-	if ((seq & 1U) == 0U) {
-		m = rx_collect(line, frame, lock, only, batch, RX_WALK_MAX);
-		if (m >= 0 && LD_ACQ(&line->rx_seq) == seq) {
-			return m;
-		}
-	}
 	k_mutex_lock(&line->lock, K_FOREVER);
 	m = rx_collect(line, frame, lock, only, batch, INT_MAX);
 	k_mutex_unlock(&line->lock);
