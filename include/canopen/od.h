@@ -65,11 +65,6 @@ extern "C" {
 #else
 #define CO_OD_PROVIDERS 0
 #endif
-/*
- * Without both, an object's co_od_info is rebuilt from its descriptor (co_od_info_fill()), and
- * a PDO mapping entry keeps only that descriptor (CO_PDO_ENT_COMPACT): one condition for both.
- */
-#define CO_OD_INFO_COMPACT (!CO_OD_COVER && !CO_OD_PROVIDERS)
 #ifdef CONFIG_CANOPEN_OD_PROVIDERS_MAX
 #define CO_OD_PROVIDERS_MAX CONFIG_CANOPEN_OD_PROVIDERS_MAX
 #elif CO_OD_PROVIDERS
@@ -572,7 +567,7 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
  *
  * For a caller that keeps the descriptor of an object found once (with the object's index,
  * object code and group) and rebuilds its info when it accesses it, instead of keeping the
- * whole info (the PDO mapping of a small build).
+ * whole info (the PDO mapping without CONFIG_CANOPEN_PDO_MAP_INFO).
  *
  * @param od      dictionary of @p desc
  * @param desc    sub-index descriptor of a dictionary object (not a provider's)
@@ -583,6 +578,26 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
  */
 void co_od_info_fill(const struct co_od *od, const struct co_od_sub *desc, uint16_t index,
 		     uint8_t objcode, uint8_t group, struct co_od_info *info);
+
+/** @cond INTERNAL_HIDDEN */
+/* co_od_info_fill() inline, for a hot path (the PDO's notify hooks). */
+static inline void co_od_info_fill_inline(const struct co_od *od, const struct co_od_sub *desc,
+					  uint16_t index, uint8_t objcode, uint8_t group,
+					  struct co_od_info *info)
+{
+	info->desc = desc;
+	info->prov = NULL;
+	info->limit = (desc->flags & CO_OD_F_LIMITS) != 0U ? &od->def->limits[desc->limit] : NULL;
+	info->size = desc->size;
+	info->index = index;
+	info->sub = desc->sub;
+	info->dtype = desc->dtype;
+	info->access = desc->access;
+	info->flags = desc->flags;
+	info->objcode = objcode;
+	info->group = group;
+}
+/** @endcond */
 
 /** @brief Current length in bytes of the value (strings up to the NUL, domains). */
 uint32_t co_od_length(const struct co_od *od, const struct co_od_info *info);

@@ -115,23 +115,35 @@ typedef void (*co_tpdo_ind_t)(struct co_node *node, uint16_t num, void *user_dat
 #define CO_TPDOS 4
 #endif
 
-/*
- * Without the hook-coverage cache and providers (the small builds) a mapping entry keeps
- * only what rebuilds its object's co_od_info (co_od_info_fill()) when a frame accesses it:
- * 8 instead of 24 bytes on a 32-bit target, for a few instructions per mapped object.
- */
-#define CO_PDO_ENT_COMPACT CO_OD_INFO_COMPACT
-
-/* One mapped object, resolved once when the mapping is enabled. */
-struct co_pdo_map_ent {
-#if CO_PDO_ENT_COMPACT
-	const struct co_od_sub *desc; /* the object's descriptor; NULL: a dummy entry */
-	uint16_t index;               /* object index; a dummy's: its type 0001h-0007h */
-	uint8_t objcode;              /* enum co_od_objcode */
-	uint8_t group;                /* enum co_od_group */
+/* Whether a mapping entry keeps its object's whole co_od_info (CONFIG_CANOPEN_PDO_MAP_INFO). */
+#if defined(CONFIG_CANOPEN_PDO_MAP_INFO)
+#define CO_PDO_ENT_INFO 1
 #else
+#define CO_PDO_ENT_INFO 0
+#endif
+
+/*
+ * One mapped object, resolved once when the mapping is enabled. Without
+ * CONFIG_CANOPEN_PDO_MAP_INFO an entry keeps what rebuilds its object's co_od_info when a
+ * frame needs it (co_od_info_fill()), not the info itself: with the cover 16 instead of 32
+ * bytes on a 32-bit target. The copy-only path of a frame needs the descriptor alone, and the
+ * info only to call a notify hook.
+ */
+struct co_pdo_map_ent {
+#if CO_PDO_ENT_INFO
 	/* The object; info.index 0001h-0007h with no desc/prov marks a dummy entry. */
 	struct co_od_info info;
+#else
+	/* The object's descriptor; NULL for a dummy and for a provider's object. */
+	const struct co_od_sub *desc;
+	uint16_t index; /* object index; a dummy's: its type 0001h-0007h */
+	uint8_t sub;    /* sub-index (0 for a dummy) */
+	/*
+	 * A dictionary object's object code (bits 0-3) and group (bits 4-5); a provider's
+	 * object: CO_PDO_ENT_PROV and its size in bytes, 1-8 (bits 0-3), as co_od_find()
+	 * describes it again at each access (pdo_internal.h).
+	 */
+	uint8_t kind;
 #endif
 #if CO_OD_COVER
 	struct co_od_cover cover; /* hooks covering the object, refreshed by the accessors */
@@ -140,8 +152,8 @@ struct co_pdo_map_ent {
 	uint8_t bits; /* mapped length */
 	bool whole;   /* the whole object, whole bytes: moved without masking */
 #endif
-	/* Without bit-wise mapping an entry is always its whole object: the length is
-	 * info.size (co_pdo_ent_bits()), 4 bytes less per entry on a 32-bit target.
+	/* Without bit-wise mapping an entry is always its whole object: the length is the
+	 * object's size (co_pdo_ent_bits()).
 	 */
 };
 

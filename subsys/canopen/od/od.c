@@ -870,24 +870,6 @@ static uint32_t provider_info(const struct co_od_provider *p, uint16_t index, ui
 	return p->api->info(p, info);
 }
 
-/* The info of a dictionary object (co_od_find(), co_od_info_fill()). */
-static ALWAYS_INLINE void info_fill(const struct co_od *od, const struct co_od_sub *desc,
-				    uint16_t index, uint8_t objcode, uint8_t group,
-				    struct co_od_info *info)
-{
-	info->desc = desc;
-	info->prov = NULL;
-	info->limit = (desc->flags & CO_OD_F_LIMITS) ? &od->def->limits[desc->limit] : NULL;
-	info->size = desc->size;
-	info->index = index;
-	info->sub = desc->sub;
-	info->dtype = desc->dtype;
-	info->access = desc->access;
-	info->flags = desc->flags;
-	info->objcode = objcode;
-	info->group = group;
-}
-
 uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct co_od_info *info)
 {
 	const struct co_od_def *def = od->def;
@@ -912,11 +894,11 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
 			return 0;
 		}
 	}
-#if CO_OD_INFO_COMPACT
-	/* One copy, shared with the compact PDO mapping entries of such a build. */
+#if defined(__OPTIMIZE_SIZE__)
+	/* One copy, shared with the PDO mapping entries, which rebuild their objects' info. */
 	co_od_info_fill(od, desc, index, e->objcode, e->group, info);
 #else
-	info_fill(od, desc, index, e->objcode, e->group, info);
+	co_od_info_fill_inline(od, desc, index, e->objcode, e->group, info);
 #endif
 	return 0;
 }
@@ -924,7 +906,7 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
 void co_od_info_fill(const struct co_od *od, const struct co_od_sub *desc, uint16_t index,
 		     uint8_t objcode, uint8_t group, struct co_od_info *info)
 {
-	info_fill(od, desc, index, objcode, group, info);
+	co_od_info_fill_inline(od, desc, index, objcode, group, info);
 }
 
 const void *co_od_value_ptr(const struct co_od *od, const struct co_od_info *info)

@@ -107,10 +107,10 @@ static enum co_mpdo_rx_result write_object(struct co_node *node, uint16_t index,
 {
 	struct co_pdo_map_ent ent = {0};
 	struct co_od_info tmp;
-	struct co_od_info *info = co_pdo_ent_find_buf(&ent, &tmp);
+	const struct co_od_info *info = &tmp;
 	uint8_t val[8] = {0};
 
-	if (co_od_find(&node->od, index, sub, info) != 0U) {
+	if (co_od_find(&node->od, index, sub, &tmp) != 0U) {
 		return dam ? CO_MPDO_RX_MISSING : CO_MPDO_RX_REFUSED;
 	}
 	if (!mpdo_sized(info)) {

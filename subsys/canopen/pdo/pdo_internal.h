@@ -63,92 +63,183 @@
 uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 			  struct co_pdo_map_ent *ent);
 
+#if !CO_PDO_ENT_INFO
+/*
+ * co_pdo_map_ent.kind (pdo.h): bit 7 a provider's object, whose size in bytes is in bits
+ * 0-3; otherwise the object code in bits 0-3 and the group in bits 4-5.
+ */
+static inline bool co_pdo_kind_prov(uint8_t kind)
+{
+	return (kind & 0x80U) != 0U;
+}
+
+static inline uint8_t co_pdo_kind_low(uint8_t kind)
+{
+	return kind & 0x0FU;
+}
+
+static inline uint8_t co_pdo_kind_group(uint8_t kind)
+{
+	return (uint8_t)(kind >> 4U) & 0x03U;
+}
+
+static inline uint8_t co_pdo_kind_of(const struct co_od_info *info)
+{
+	if (CO_OD_PROVIDERS && info->desc == NULL) {
+		/* A mapped object is a number of at most 8 bytes (co_pdo_map_check()). */
+		return (uint8_t)(0x80U | (info->size & 0x0FU));
+	}
+	return (uint8_t)((info->objcode & 0x0FU) | ((uint32_t)(info->group & 0x03U) << 4U));
+}
+#endif
+
+/* An entry's dictionary descriptor (NULL for a dummy and a provider's object). */
+static inline const struct co_od_sub *co_pdo_ent_desc(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_INFO
+	return ent->info.desc;
+#else
+	return ent->desc;
+#endif
+}
+
+/* Whether an entry is an object of a provider (never without providers). */
+static inline bool co_pdo_ent_is_prov(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_INFO
+	return CO_OD_PROVIDERS && ent->info.prov != NULL;
+#else
+	return CO_OD_PROVIDERS && co_pdo_kind_prov(ent->kind);
+#endif
+}
+
 /* Whether an entry is a dummy (skips bits of an RPDO). */
 static inline bool co_pdo_ent_is_dummy(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_COMPACT
-	return ent->desc == NULL;
-#else
-	return ent->info.desc == NULL && ent->info.prov == NULL;
-#endif
+	return co_pdo_ent_desc(ent) == NULL && !co_pdo_ent_is_prov(ent);
 }
 
 /* An entry's object index (a dummy's: its type 0001h-0007h). */
 static inline uint16_t co_pdo_ent_index(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_COMPACT
-	return ent->index;
-#else
+#if CO_PDO_ENT_INFO
 	return ent->info.index;
+#else
+	return ent->index;
 #endif
 }
 
 /* An entry's sub-index (0 for a dummy). */
 static inline uint8_t co_pdo_ent_sub(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_COMPACT
-	return ent->desc != NULL ? ent->desc->sub : 0U;
-#else
+#if CO_PDO_ENT_INFO
 	return ent->info.sub;
+#else
+	return ent->sub;
 #endif
 }
 
 /* An entry's object size on the wire in bytes (a dummy's: its type's whole bytes). */
 static inline uint32_t co_pdo_ent_size(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_COMPACT
-	return ent->desc != NULL ? ent->desc->size : co_dtype_size(ent->index);
-#else
+#if CO_PDO_ENT_INFO
 	return ent->info.size;
+#else
+	if (ent->desc != NULL) {
+		return ent->desc->size;
+	}
+	if (co_pdo_ent_is_prov(ent)) {
+		return co_pdo_kind_low(ent->kind);
+	}
+	return co_dtype_size(ent->index);
 #endif
 }
 
+/* The size of an entry of a dictionary object (a marked mapping's: co_pdo_ent_desc() set). */
+static inline uint32_t co_pdo_ent_desc_size(const struct co_pdo_map_ent *ent)
+{
+#if CO_PDO_ENT_INFO
+	return ent->info.size;
+#else
+	return ent->desc->size;
+#endif
+}
+
+/* Make @p ent a dummy entry of type @p index (0001h-0007h) of @p bytes whole bytes. */
+static inline void co_pdo_ent_set_dummy(struct co_pdo_map_ent *ent, uint16_t index, uint32_t bytes)
+{
+#if CO_PDO_ENT_INFO
+	ent->info.index = index;
+	ent->info.dtype = (uint8_t)index;
+	/* Its whole bytes: the length co_pdo_ent_bits() gives without bit-wise mapping. */
+	ent->info.size = bytes;
+#else
+	/* Its whole bytes are its type's size (co_pdo_ent_size()). */
+	(void)bytes;
+	ent->index = index;
+#endif
+}
+
+#if !CO_PDO_ENT_INFO
+/*
+ * A provider's object is described again by co_od_find(), as when it was mapped (a
+ * provider's description stays what it was while it is registered): 0 or its abort code.
+ */
+uint32_t co_pdo_ent_prov_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
+			      struct co_od_info *tmp);
+#endif
+
 /*
  * The co_od_info of an entry that is not a dummy, for the accessors: its own, or rebuilt in
- * @p tmp from what a compact entry keeps.
+ * @p tmp from what a compact entry keeps; NULL if a provider no longer describes it.
  */
 static inline const struct co_od_info *
 co_pdo_ent_info(const struct co_od *od, const struct co_pdo_map_ent *ent, struct co_od_info *tmp)
 {
-#if CO_PDO_ENT_COMPACT
-	co_od_info_fill(od, ent->desc, ent->index, ent->objcode, ent->group, tmp);
-	return tmp;
-#else
+#if CO_PDO_ENT_INFO
 	(void)od;
 	(void)tmp;
 	return &ent->info;
+#else
+	if (co_pdo_ent_is_prov(ent)) {
+		return co_pdo_ent_prov_info(od, ent, tmp) == 0U ? tmp : NULL;
+	}
+	co_od_info_fill(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
+			co_pdo_kind_group(ent->kind), tmp);
+	return tmp;
 #endif
 }
 
-/*
- * Where co_od_find() describes an entry's object: the entry's own info, or @p tmp for a
- * compact entry; co_pdo_ent_set() then makes it the entry's object.
- */
-static inline struct co_od_info *co_pdo_ent_find_buf(struct co_pdo_map_ent *ent,
-						     struct co_od_info *tmp)
+/* As co_pdo_ent_info() for an entry with a descriptor, inline (the notify hooks of a frame). */
+static inline const struct co_od_info *co_pdo_ent_desc_info(const struct co_od *od,
+							    const struct co_pdo_map_ent *ent,
+							    struct co_od_info *tmp)
 {
-#if CO_PDO_ENT_COMPACT
-	(void)ent;
-	return tmp;
-#else
+#if CO_PDO_ENT_INFO
+	(void)od;
 	(void)tmp;
 	return &ent->info;
+#elif defined(__OPTIMIZE_SIZE__)
+	co_od_info_fill(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
+			co_pdo_kind_group(ent->kind), tmp);
+	return tmp;
+#else
+	co_od_info_fill_inline(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
+			       co_pdo_kind_group(ent->kind), tmp);
+	return tmp;
 #endif
 }
 
-/* Make @p ent the entry of the dictionary object @p info (from co_od_find()). */
+/* Make @p ent the entry of the object @p info (from co_od_find(), mapped whole or in part). */
 static inline void co_pdo_ent_set(struct co_pdo_map_ent *ent, const struct co_od_info *info)
 {
-#if CO_PDO_ENT_COMPACT
-	/* Without providers every object found has a descriptor. */
+#if CO_PDO_ENT_INFO
+	ent->info = *info;
+#else
 	ent->desc = info->desc;
 	ent->index = info->index;
-	ent->objcode = info->objcode;
-	ent->group = info->group;
-#else
-	if (info != &ent->info) {
-		ent->info = *info;
-	}
+	ent->sub = info->sub;
+	ent->kind = co_pdo_kind_of(info);
 #endif
 }
 
@@ -222,9 +313,11 @@ static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_p
 		unsigned int off = 0;
 
 		for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
-			unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
+			/* A marked mapping holds whole dictionary objects only. */
+			unsigned int bytes = co_pdo_ent_desc_size(ent);
 
-			(void)co_od_copy_word(&frame[off], od->ram + ent->info.desc->offset, bytes);
+			(void)co_od_copy_word(&frame[off], od->ram + co_pdo_ent_desc(ent)->offset,
+					      bytes);
 			off += bytes;
 		}
 		memcpy(data, frame, sizeof(frame));
@@ -249,11 +342,23 @@ static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *
 
 		for (uint8_t i = 0; i < map->n; i++) {
 			struct co_pdo_map_ent *ent = &map->ent[i];
-			unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
+			unsigned int bytes = co_pdo_ent_desc_size(ent);
 
-			(void)co_od_copy_word(od->ram + ent->info.desc->offset, &data[off], bytes);
-			co_od_cover_notify(od, &ent->info, CO_PDO_ENT_COVER(ent), &data[off], bytes,
+			(void)co_od_copy_word(od->ram + co_pdo_ent_desc(ent)->offset, &data[off],
+					      bytes);
+#if CO_PDO_ENT_INFO
+			co_od_cover_notify(od, &ent->info, &ent->cover, &data[off], bytes,
 					   CO_OD_WRITER_PDO);
+#else
+			if ((ent->cover.flags & CO_OD_COVER_NOTIFY1) != 0U) {
+				/* The hook sees the object as co_od_find() describes it. */
+				struct co_od_info tmp;
+
+				co_od_cover_notify(od, co_pdo_ent_desc_info(od, ent, &tmp),
+						   &ent->cover, &data[off], bytes,
+						   CO_OD_WRITER_PDO);
+			}
+#endif
 			off += bytes;
 			/* A hook that changed the hook table: the rest entry by entry. */
 			if (unlikely(od->hook_gen != gen)) {

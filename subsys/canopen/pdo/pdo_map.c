@@ -59,20 +59,12 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 		    (!bitwise && bits % 8U != 0U)) {
 			return CO_SDO_AB_NO_MAP;
 		}
-#if CO_PDO_ENT_COMPACT
-		/* Its whole bytes are its type's size (co_pdo_ent_size()). */
-		ent->index = index;
-#else
-		ent->info.index = index;
-		ent->info.dtype = (uint8_t)index;
-		/* Its whole bytes: the length co_pdo_ent_bits() gives without bit-wise mapping. */
-		ent->info.size = (uint32_t)bits / 8U;
-#endif
+		co_pdo_ent_set_dummy(ent, index, (uint32_t)bits / 8U);
 		return 0U;
 	}
 	struct co_od_info tmp;
-	struct co_od_info *info = co_pdo_ent_find_buf(ent, &tmp);
-	uint32_t ab = co_od_find(od, index, sub, info);
+	const struct co_od_info *info = &tmp;
+	uint32_t ab = co_od_find(od, index, sub, &tmp);
 
 	if (ab != 0U) {
 		return ab;
@@ -127,17 +119,29 @@ void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8
 	}
 }
 
+#if !CO_PDO_ENT_INFO
+uint32_t co_pdo_ent_prov_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
+			      struct co_od_info *tmp)
+{
+	return co_od_find(od, ent->index, ent->sub, tmp);
+}
+#endif
+
 uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uint8_t out[8],
 			 enum co_od_writer reader)
 {
 	size_t len = 0;
 	struct co_od_info tmp;
 	const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
-	size_t cap = info->size < 8U ? info->size : 8U;
 	unsigned int whole = co_pdo_ent_bits(ent) / 8U;
 	uint32_t ab;
 
 	memset(out, 0, 8);
+	if (info == NULL) {
+		return CO_SDO_AB_NO_OBJECT;
+	}
+	size_t cap = info->size < 8U ? info->size : 8U;
+
 	ab = co_od_read_cached(od, info, CO_PDO_ENT_COVER(ent), out, cap, &len, reader);
 	if (ab != 0U) {
 		memset(out, 0, 8);
@@ -160,6 +164,10 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 	uint8_t buf[8];
 	struct co_od_info tmp;
 	const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
+
+	if (info == NULL) {
+		return CO_SDO_AB_NO_OBJECT;
+	}
 	uint32_t size = info->size;
 
 	memcpy(buf, val, sizeof(buf));
@@ -184,7 +192,7 @@ static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool
 		const struct co_pdo_map_ent *ent = &map->ent[i];
 		unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
 
-		if (!co_pdo_ent_whole(ent) || co_pdo_ent_is_dummy(ent) || ent->info.desc == NULL ||
+		if (!co_pdo_ent_whole(ent) || co_pdo_ent_desc(ent) == NULL ||
 		    (bytes != 1U && bytes != 2U && bytes != 4U && bytes != 8U) ||
 		    !(rx ? co_od_cover_plain_write(od, CO_PDO_ENT_COVER(ent))
 			 : co_od_cover_plain_read(od, CO_PDO_ENT_COVER(ent)))) {
@@ -229,8 +237,10 @@ uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint
 
 		if (!BITWISE || (map->bytewise && co_pdo_ent_whole(ent))) {
 			/* Straight into the frame: the mapping check made the sizes fit. */
-			if (co_od_read_cached(od, co_pdo_ent_info(od, ent, &tmp),
-					      CO_PDO_ENT_COVER(ent), &data[off / 8U],
+			const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
+
+			if (info == NULL ||
+			    co_od_read_cached(od, info, CO_PDO_ENT_COVER(ent), &data[off / 8U],
 					      co_pdo_ent_bits(ent) / 8U, &len,
 					      CO_OD_WRITER_PDO) != 0U) {
 				memset(&data[off / 8U], 0, co_pdo_ent_bits(ent) / 8U);
@@ -262,8 +272,10 @@ int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_
 
 		if (BITWISE ? map->bytewise && co_pdo_ent_whole(ent) : !co_pdo_ent_is_dummy(ent)) {
 			/* A whole object in whole bytes: its wire value is in the frame. */
-			refused += co_od_write_cached(od, co_pdo_ent_info(od, ent, &tmp),
-						      CO_PDO_ENT_COVER(ent), &data[off],
+			const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
+
+			refused += info == NULL ||
+				   co_od_write_cached(od, info, CO_PDO_ENT_COVER(ent), &data[off],
 						      co_pdo_ent_bits(ent) / 8U,
 						      CO_OD_WRITER_PDO) != 0U;
 		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {

@@ -519,24 +519,120 @@ ZTEST(co_pdo, test_rpdo_hooks_see_the_mapped_objects_as_found)
 	co_node_unlock(&t.node);
 }
 
-/* Without the cache and providers a mapping entry keeps a descriptor and three small fields
- * (CO_PDO_ENT_COMPACT); with either it keeps the whole co_od_info.
+/*
+ * Without CONFIG_CANOPEN_PDO_MAP_INFO a mapping entry keeps what rebuilds its object's
+ * co_od_info, not the info itself: a pointer and four bytes, and the cover beside them when
+ * the build has one.
  */
 ZTEST(co_pdo, test_map_entry_compact)
 {
-	bool compact =
-		!IS_ENABLED(CONFIG_CANOPEN_OD_COVER) && !IS_ENABLED(CONFIG_CANOPEN_OD_PROVIDERS);
+	size_t want = sizeof(void *) + 4U;
 
-	zassert_equal(CO_PDO_ENT_COMPACT, compact);
-	if (!compact) {
+	zassert_equal(CO_PDO_ENT_INFO, IS_ENABLED(CONFIG_CANOPEN_PDO_MAP_INFO));
+	if (CO_PDO_ENT_INFO) {
 		zassert_true(sizeof(struct co_pdo_map_ent) >= sizeof(struct co_od_info));
 		return;
 	}
+	if (IS_ENABLED(CONFIG_CANOPEN_OD_COVER)) {
+		want += sizeof(struct co_od_cover);
+	}
 	zassert_true(sizeof(struct co_pdo_map_ent) < sizeof(struct co_od_info));
 	if (!IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)) {
-		zassert_equal(sizeof(struct co_pdo_map_ent), 2U * sizeof(void *));
+		zassert_equal(sizeof(struct co_pdo_map_ent), ROUND_UP(want, sizeof(void *)));
 	}
 }
+
+#if defined(CONFIG_CANOPEN_OD_PROVIDERS)
+/*
+ * Objects of a provider mapped into PDOs: 3000h:01 (U16) and 3000h:02 (U8), read, written
+ * and described by the provider, whatever the mapping entry keeps of them.
+ */
+static struct {
+	uint16_t u16;
+	uint8_t u8;
+	int infos;
+	int reads;
+	int writes;
+} pv;
+
+static uint32_t pv_info(const struct co_od_provider *p, struct co_od_info *info)
+{
+	pv.infos++;
+	if (info->sub < 1U || info->sub > 2U) {
+		return CO_SDO_AB_NO_SUB;
+	}
+	info->dtype = info->sub == 1U ? CO_DTYPE_UNSIGNED16 : CO_DTYPE_UNSIGNED8;
+	info->size = info->sub == 1U ? 2U : 1U;
+	info->access = CO_OD_ACCESS_RW;
+	info->flags = CO_OD_F_MAP;
+	return 0U;
+}
+
+static uint32_t pv_read(const struct co_od_provider *p, const struct co_od_info *info,
+			uint32_t offset, void *buf, size_t cap, size_t *len)
+{
+	uint8_t v[2];
+
+	pv.reads++;
+	co_od_le_put(v, info->size, info->sub == 1U ? pv.u16 : pv.u8);
+	*len = info->size <= cap ? info->size : cap;
+	memcpy(buf, v, *len);
+	return 0U;
+}
+
+static uint32_t pv_write(const struct co_od_provider *p, const struct co_od_info *info,
+			 uint32_t offset, const void *data, size_t len, bool last)
+{
+	pv.writes++;
+	zassert_equal(len, info->size, "the whole object");
+	if (info->sub == 1U) {
+		pv.u16 = (uint16_t)co_od_le_get(data, 2);
+	} else {
+		pv.u8 = (uint8_t)co_od_le_get(data, 1);
+	}
+	return 0U;
+}
+
+static const struct co_od_provider_api pv_api = {
+	.info = pv_info, .read = pv_read, .write = pv_write};
+static const struct co_od_provider pv_prov = {
+	.api = &pv_api, .index_first = 0x3000, .index_last = 0x3000};
+
+ZTEST(co_pdo, test_provider_objects_in_rpdo_and_tpdo)
+{
+	const uint32_t rmap[] = {0x30000110, 0x30000208};
+	const uint32_t tmap[] = {0x30000208, 0x30000110};
+
+	memset(&pv, 0, sizeof(pv));
+	co_node_lock(&t.node);
+	zassert_ok(co_od_provider_register(co_node_od(&t.node), &pv_prov));
+	co_node_unlock(&t.node);
+	setup_pdo(true, 1, 0x321, 255, rmap, 2);
+	setup_pdo(false, 1, 0x2A1, 255, tmap, 2);
+	go_operational();
+
+	co_sim_rx(0x321, 3, (const uint8_t[]){0x34, 0x12, 0x56});
+	zassert_equal(pv.u16, 0x1234);
+	zassert_equal(pv.u8, 0x56);
+	zassert_equal(pv.writes, 2);
+	co_sim_rx(0x321, 3, (const uint8_t[]){0x78, 0x9A, 0xBC});
+	zassert_equal(pv.u16, 0x9A78);
+	zassert_equal(pv.u8, 0xBC);
+	zassert_equal(pv.writes, 4);
+
+	/* Each object an RPDO wrote was a change of state of the TPDO (no inhibit time). */
+	zassert_equal(count(0x2A1), 4);
+	zassert_mem_equal(nth(0x2A1, 3)->data, ((const uint8_t[]){0xBC, 0x78, 0x9A}), 3);
+	sim.n_sent = 0;
+	pv.reads = 0;
+	zassert_ok(co_tpdo_send_req(&t.node, 1));
+	zassert_equal(count(0x2A1), 1);
+	zassert_equal(nth(0x2A1, 0)->dlc, 3);
+	zassert_mem_equal(nth(0x2A1, 0)->data, ((const uint8_t[]){0xBC, 0x78, 0x9A}), 3);
+	zassert_equal(pv.reads, 2);
+	zassert_equal(t.n_rpdo_ind, 2);
+}
+#endif
 
 /* A read check registered on a mapped object after the TPDO went out is heard: zeros. */
 static uint32_t no_read_2002(const struct co_od *od, const struct co_od_info *info,
