@@ -199,7 +199,7 @@ struct co_tpdo {
 	struct co_timer event_timer;   /* event timer, 1800h sub 5 */
 	struct co_pdo_map map;
 	struct co_node *node;
-	uint64_t inhibit_end;
+	co_time4_t inhibit_end; /* 4-aligned: no padding before it on a 32-bit target */
 	uint32_t cob_id;
 	uint32_t inhibit_us;
 	uint16_t event_ms;
