@@ -35,7 +35,8 @@ LOG_MODULE_REGISTER(co_line, CONFIG_CANOPEN_LOG_LEVEL);
 #define CO_HOT_INLINE ALWAYS_INLINE
 #endif
 
-#define SFF_MASK 0x7ffU
+/* The 11-bit identifiers, 0 to 7FFh. */
+#define SFF_MASK (CO_LINE_SFF_IDS - 1U)
 #define EFF_MASK 0x1fffffffU
 
 uint64_t co_line_now(void)
