@@ -1012,9 +1012,9 @@ int co_sdo_srv_init(struct co_sdo_srv *srv, struct co_node *node, uint8_t num)
 	(void)memset(srv, 0, sizeof(*srv));
 	srv->node = node;
 	srv->num = num;
-	srv->cob_rx = CO_SDO_COBID_INVALID;
-	srv->cob_tx = CO_SDO_COBID_INVALID;
-	srv->route = CO_ROUTE_DEFAULT;
+	/* The COB-IDs and the route are set before their first use: srv_configure() at Reset
+	 * Communication, srv_rx() for each request.
+	 */
 	srv->rx.handler = srv_rx;
 	srv->rx.lock = &node->lock;
 	srv->rx.user_data = srv;
