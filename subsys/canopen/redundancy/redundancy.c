@@ -602,6 +602,9 @@ uint8_t co_redundancy_get(struct co_node *node, enum co_rdn_state *state, uint32
 bool co_rdn_is_copy(struct co_rdn_taken *ring, uint8_t n, uint8_t *next, uint8_t line,
 		    const struct can_frame *frame, uint64_t now_us)
 {
+	/* Classic CAN: a DLC of 9 to 15 carries 8 bytes, all the frame's data holds. */
+	size_t len = MIN(frame->dlc, sizeof(ring->data));
+
 	for (uint8_t k = 0U; k < n; k++) {
 		/* Oldest first: equal values pair with their copies in the order sent. */
 		struct co_rdn_taken *e = &ring[(*next + k) % n];
@@ -609,7 +612,7 @@ bool co_rdn_is_copy(struct co_rdn_taken *ring, uint8_t n, uint8_t *next, uint8_t
 
 		if (e->used && !e->copied && e->line != line && e->id == (uint16_t)frame->id &&
 		    e->len == frame->dlc && age <= CONFIG_CANOPEN_REDUNDANCY_DUP_WINDOW_US &&
-		    memcmp(frame->data, e->data, frame->dlc) == 0) {
+		    memcmp(frame->data, e->data, len) == 0) {
 			/*
 			 * A line delivers one producer's frames in the order sent: the older
 			 * frames of this producer taken from the other line that this line has
@@ -635,6 +638,6 @@ bool co_rdn_is_copy(struct co_rdn_taken *ring, uint8_t n, uint8_t *next, uint8_t
 				   .len = frame->dlc,
 				   .line = line,
 				   .used = true};
-	(void)memcpy(e->data, frame->data, MIN(frame->dlc, sizeof(e->data)));
+	(void)memcpy(e->data, frame->data, len);
 	return false;
 }

@@ -411,6 +411,30 @@ ZTEST(co_redundancy, test_a_copy_150_ms_late_is_dropped)
 	zassert_equal(co_pdo_rx_duplicates(&t.node), 1);
 }
 
+/*
+ * A classic CAN frame may carry a DLC of 9 to 15, meaning 8 bytes: its copy is found by those
+ * 8 bytes (nothing past the frame's data is read), and a frame that differs in them is none.
+ */
+ZTEST(co_redundancy, test_a_pdo_copy_with_a_dlc_over_8_is_compared_by_its_8_bytes)
+{
+	const uint8_t start[2] = {0x01, NODE_ID};
+	struct can_frame f = {.id = 0x182, .dlc = 12, .data = {0x33, 1, 2, 3, 4, 5, 6, 7}};
+
+	rx(D, 0x000, 2, start);
+	co_line_rx(&t.line[D], &f, t.now);
+	run_until(t.now + 1 * MS);
+	co_line_rx(&t.line[R], &f, t.now);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 1, "its copy is dropped");
+	zassert_equal(rpdo_value(), 0x33);
+
+	f.data[0] = 0x44;
+	co_line_rx(&t.line[D], &f, t.now);
+	run_until(t.now + 1 * MS);
+	f.data[7] = 0x70;
+	co_line_rx(&t.line[R], &f, t.now);
+	zassert_equal(co_pdo_rx_duplicates(&t.node), 1, "a frame that differs in byte 7 is new");
+}
+
 /* A cut controller's held frame, or frames a flood held up, come late on a failing line. */
 ZTEST(co_redundancy, test_pdo_frames_of_a_line_that_lost_a_heartbeat_are_not_taken)
 {
