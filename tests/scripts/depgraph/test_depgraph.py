@@ -172,7 +172,7 @@ def test_missing_or_empty_build_dir(tmp_path):
 @pytest.mark.parametrize("obj,src", [
     ("zephyr/safeline/subsys/canopen/core/CMakeFiles/canopen_core.dir/node.c.o", "core/node.c"),
     ("zephyr/safeline/subsys/canopen/CMakeFiles/canopen.dir/x/y.c.o", "x/y.c"),
-    ("CMakeFiles/app.dir/work/main/subsys/canopen/pdo/pdo.c.o", "pdo/pdo.c"),
+    ("CMakeFiles/app.dir/path/to/safeline/subsys/canopen/pdo/pdo.c.o", "pdo/pdo.c"),
     ("zephyr/safeline/kernel/posix/CMakeFiles/kernel.dir/sched.c.o", None),
     ("CMakeFiles/app.dir/src/main.c.o", None),
 ])
