@@ -52,7 +52,8 @@ static struct co_node nodes[LINES_MAX];
 static struct pdo_io_od_ram rams[LINES_MAX];
 static K_THREAD_STACK_ARRAY_DEFINE(stacks, LINES_MAX, CONFIG_CANOPEN_LINE_STACK_SIZE);
 static char names[LINES_MAX][12];
-static int n_lines = LINES_MAX;
+static int32_t lines_arg; /* INT32_MAX when --lines is not given */
+static int n_lines;
 
 static void add_options(void)
 {
@@ -61,7 +62,7 @@ static void add_options(void)
 			.option = "lines",
 			.name = "N",
 			.type = 'i',
-			.dest = &n_lines,
+			.dest = &lines_arg,
 			.descript = "lines (and nodes) on the bus, 16 to 255 (default 255)",
 		},
 		ARG_TABLE_ENDMARKER,
@@ -158,6 +159,7 @@ int main(void)
 	double c0, c1, cpu_per_line_us;
 	int th1;
 
+	n_lines = lines_arg == INT32_MAX ? LINES_MAX : lines_arg;
 	if (n_lines < LINES_MIN || n_lines > LINES_MAX) {
 		printf("scale_bench: --lines must be %d to %d, not %d\n", LINES_MIN, LINES_MAX,
 		       n_lines);
