@@ -20,7 +20,18 @@ class Platform:
     timeout_multiplier: float = 1.0
     only_tags: list = field(default_factory=list)
     ignore_tags: list = field(default_factory=list)
+    # `simulation:` entries, Zephyr's spelling: [{name, exec}]. The first one with an `exec`
+    # names the program that runs the image (qemu-user for a board of another CPU).
+    simulation: list = field(default_factory=list)
     path: Path | None = None
+
+    @property
+    def emulator(self) -> str | None:
+        """The program the image runs under (`<exec> zephyr.exe <args>`), None for the host."""
+        for sim in self.simulation:
+            if sim.get("exec"):
+                return sim["exec"]
+        return None
 
     @classmethod
     def from_dict(cls, data: dict, path: Path | None = None) -> "Platform":
@@ -38,6 +49,7 @@ class Platform:
             timeout_multiplier=float(testing.get("timeout_multiplier", 1.0)),
             only_tags=list(testing.get("only_tags") or []),
             ignore_tags=list(testing.get("ignore_tags") or []),
+            simulation=[dict(sim) for sim in data.get("simulation") or []],
             path=path,
         )
 

@@ -31,6 +31,7 @@ class RunSpec:
     env: dict = field(default_factory=dict)  # added to the environment
     ignore_faults: bool = False
     base: str = ""  # the repo root (SAFELINE_BASE)
+    emulator: str = ""  # the board's `simulation` exec the image runs under; "" for the host
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -101,6 +102,9 @@ def execute(spec: RunSpec, echo=None) -> RunResult:
     env["SAFELINE_BASE"] = spec.base
     env["SAFELINE_BUILD_DIR"] = str(build_dir)
     env["SAFELINE_IMAGE"] = str(spec.image)
+    if spec.emulator:
+        # For pytest scenarios that start the image themselves.
+        env["SAFELINE_EMULATOR"] = spec.emulator
 
     if spec.harness == "pytest":
         junit = build_dir / "report.xml"
@@ -117,6 +121,8 @@ def execute(spec: RunSpec, echo=None) -> RunResult:
         else:
             harness = ZtestHarness(spec.scenario, spec.expected_cases, spec.ignore_faults)
         cmd = [str(spec.image), *spec.image_args]
+        if spec.emulator:
+            cmd.insert(0, spec.emulator)
         cwd = str(build_dir)
 
     res = handler.run(cmd, cwd=cwd, env=env, timeout=spec.timeout, log_path=log_path, on_line=harness.feed, echo=echo)

@@ -8,6 +8,7 @@ well). A progress line is printed as each instance finishes.
 """
 
 import os
+import shutil
 import signal
 import threading
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
@@ -115,6 +116,7 @@ class Runner:
             env=env,
             ignore_faults=bool(sc.get("ignore_faults")),
             base=str(self.opts.base),
+            emulator=plat.emulator or "",
         )
 
     def apply_result(self, inst: TestInstance, result: RunResult) -> None:
@@ -211,6 +213,12 @@ class Runner:
         fixture = sc.fixture
         if fixture and fixture not in self.opts.fixtures:
             inst.set_status(st.SKIPPED, f"fixture {fixture} not available")
+            inst.fill_cases(st.SKIPPED, inst.reason)
+            return True
+        emulator = inst.platform.emulator
+        if emulator and shutil.which(emulator) is None:
+            # Built (so it cannot rot), not run: like a missing fixture, never a failure.
+            inst.set_status(st.SKIPPED, f"emulator {emulator} not found")
             inst.fill_cases(st.SKIPPED, inst.reason)
             return True
         if fixture == VCAN_FIXTURE:
