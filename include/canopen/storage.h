@@ -17,7 +17,9 @@
  * (1000h-1FFFh), 3 application (6000h-9FFFh), 4 manufacturer (2000h-5FFFh). Writing "load"
  * (64616F6Ch) to 1011h sub n drops the stored group, so the defaults apply from the next
  * Reset Node / Reset Communication (CiA 301 §7.5.2.13, §7.5.2.14). Other values are refused
- * with 08000020h; a backend failure with 06060000h.
+ * with 08000020h; a backend failure with 06060000h; a request while the application forbids
+ * it (co_storage_set_locked()) with 08000021h. A node without medium says so
+ * (co_storage_init_absent()): 1010h/1011h read 0 and every request is refused with 08000020h.
  *
  * Like the object dictionary, calls must be made with the node's mutex held.
  */
@@ -25,6 +27,7 @@
 #ifndef SAFELINE_INCLUDE_CANOPEN_STORAGE_H_
 #define SAFELINE_INCLUDE_CANOPEN_STORAGE_H_
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -119,6 +122,9 @@ struct co_storage {
 	uint32_t seq;       /**< sequence number of the current image */
 	int8_t active;      /**< slot holding the current image, -1 if none */
 	uint32_t skipped;   /**< stored values refused or unknown at the last restore */
+	bool absent;        /**< no medium: 1010h/1011h read 0, requests refused */
+	bool locked;        /**< local control forbids requests (08000021h) */
+	bool own_write;     /**< the module writes 1010h/1011h itself (not a request) */
 	uint8_t buf[CO_STORAGE_CHUNK];
 };
 
@@ -136,12 +142,37 @@ struct co_storage {
 int co_storage_init(struct co_storage *st, struct co_od *od, const struct co_storage_backend *be);
 
 /**
+ * @brief Declare that the node has no storage medium (none attached, or it cannot be used).
+ *
+ * 1010h and 1011h sub-indexes 1.. then read 0 ("does not save on command", "does not restore
+ * defaults", CiA 301 §7.5.2.13-14), after every reset too, and a save or restore request is
+ * refused with 08000020h (a wrong signature as well). co_storage_save() and
+ * co_storage_clear() return -ENODEV.
+ *
+ * @retval 0 success
+ * @retval -EINVAL bad arguments
+ * @retval -ENOSPC no hook slot left in the dictionary
+ * @retval -EROFS a sub-index could not be set to 0 (it keeps its value; requests are refused)
+ */
+int co_storage_init_absent(struct co_storage *st, struct co_od *od);
+
+/**
+ * @brief Let local control forbid save and restore requests, or allow them again.
+ *
+ * While locked, a 1010h/1011h write with the right signature is refused with 08000021h
+ * ("because of local control"); the sub-indexes keep reading what the node supports. The
+ * application's own co_storage_save()/co_storage_clear() calls are not affected.
+ */
+void co_storage_set_locked(struct co_storage *st, bool locked);
+
+/**
  * @brief Save the current values of the groups in @p group_mask (CO_OD_GROUP_BIT()).
  *
  * Groups not in the mask keep their stored values.
  *
  * @retval 0 saved
  * @retval -ENOSPC the image does not fit in a slot
+ * @retval -ENODEV no medium (co_storage_init_absent())
  * @retval -EIO / other negative errno from the backend; the previous image stays current
  */
 int co_storage_save(struct co_storage *st, uint32_t group_mask);

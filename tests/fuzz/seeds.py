@@ -168,6 +168,37 @@ SEEDS["cdcf"] = {
 }
 
 
+def dcf(slaves=(2, 3), files=None, cut=None):
+    """A network DCF as the manager reads it (--dcf): the mandatory objects, 1F80h, 1F89h,
+    1F81h and 1F85h as compact arrays, heartbeat consumers, concise DCFs in 1F22h."""
+    lines = ["[1000]", "ParameterValue=0", "[1001]", "ParameterValue=0", "[1018]",
+             "SubNumber=1", "[DeviceComissioning]", "NodeID=0x01", "[1F80]",
+             "ParameterValue=0x00000001", "[1F89]", "ParameterValue=2000"]
+    for index, value in (("1F81", 0x0D), ("1F85", 0x539)):
+        lines += [f"[{index}]", "CompactSubObj=127", "DefaultValue=0", f"[{index}Value]",
+                  f"NrOfEntries={len(slaves)}"]
+        lines += [f"0x{n:X}={value}" if n % 2 == 0 else f"{n}=0x{value:08X}" for n in slaves]
+    lines += ["[1016]", "SubNumber=2", "[1016sub1]", f"ParameterValue=0x00{slaves[0]:02X}012C"]
+    if files:
+        lines += ["[1F22]", "SubNumber=128"]
+        for n, name in files.items():
+            lines += [f"[1F22sub{n:X}]", f"UploadFile={name}"]
+    text = ("\n".join(lines) + "\n").encode()
+    return text if cut is None else text[:text.index(cut.encode()) + len(cut)]
+
+
+SEEDS["dcf"] = {
+    "network": dcf(files={2: "slave.bin"}),
+    "fifo": dcf(files={2: "fifo.bin"}),
+    "cut-in-1F81Value": dcf(slaves=(2, 3, 4, 5), cut="3=0x00"),
+    "nr-of-entries": dcf().replace(b"NrOfEntries=2", b"NrOfEntries=4", 1),
+    "sub-zz": dcf().replace(b"[1016sub1]", b"[1016subZZ]"),
+    "duplicate-key": dcf().replace(b"ParameterValue=2000", b"ParameterValue=2000\n"
+                                   b"ParameterValue=100"),
+    "empty": b"",
+}
+
+
 def main():
     for name, seeds in SEEDS.items():
         d = os.path.join(HERE, name, "corpus")

@@ -72,7 +72,7 @@ class BridgeClient:
                  bridge=None):
         xml, self.config_desc = config.load(dds_config)
         self.domain_id = domain_id
-        self._domain = config.domain(domain_id, xml)
+        self._domain = config.domain(domain_id, xml, self.config_desc)
         self.dp = DomainParticipant(domain_id)
         self.client_id = config.client_id(name)
         self.bridge = bridge

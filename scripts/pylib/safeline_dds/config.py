@@ -9,6 +9,8 @@ domain explicitly, and Cyclone then ignores the variable.
 """
 
 import os
+import sys
+import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -47,6 +49,23 @@ def loopback_problems(xml_text):
     return problems
 
 
+def checked_xml(text, where):
+    """text, if it is a Cyclone DDS configuration; else ConfigError in one line.
+
+    Cyclone takes text that is not XML for a list of file names, and its domain then fails
+    with an exception that says nothing of the file."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as e:
+        raise ConfigError(f"{where}: not a Cyclone DDS configuration: not XML ({e})")
+    if root.tag.rpartition("}")[2] != "CycloneDDS":
+        raise ConfigError(f"{where}: not a Cyclone DDS configuration: the root element is "
+                          f"<{root.tag.rpartition('}')[2]}>, not <CycloneDDS>")
+    if not text.isascii():
+        raise ConfigError(f"{where}: not a Cyclone DDS configuration: Cyclone takes ASCII only")
+    return text
+
+
 def load(dds_config=None):
     """(XML text, description) of the configuration to use.
 
@@ -54,12 +73,19 @@ def load(dds_config=None):
     """
     if dds_config:
         if dds_config.lstrip().startswith("<"):
-            return dds_config, "the configuration given"
+            return checked_xml(dds_config, "the configuration given"), "the configuration given"
         path = Path(dds_config[7:] if dds_config.startswith("file://") else dds_config)
+        if path.exists() and not path.is_file():
+            # A FIFO or a device would block read_text(); a directory is no file either.
+            raise ConfigError(f"cannot read the DDS configuration {path}: not a regular file")
         try:
-            return path.read_text(), str(path)
+            text = path.read_bytes().decode("utf-8")
         except OSError as e:
             raise ConfigError(f"cannot read the DDS configuration {path}: {e.strerror}")
+        except UnicodeDecodeError as e:
+            raise ConfigError(f"{path}: not a Cyclone DDS configuration: not UTF-8 text "
+                              f"(byte {e.start})")
+        return checked_xml(text, str(path)), str(path)
     try:
         text = LOOPBACK.read_text()
     except OSError:
@@ -76,17 +102,47 @@ def load(dds_config=None):
 _domains = {}
 
 
-def domain(domain_id, xml_text):
+def domain(domain_id, xml_text, where="the configuration"):
     """The process's domain object for domain_id, created once with the configuration."""
     from cyclonedds.domain import Domain
 
     d = _domains.get(domain_id)
     if d is None:
-        d = (Domain(domain_id, xml_text), xml_text)
+        d = (_create_domain(Domain, domain_id, xml_text, where), xml_text)
         _domains[domain_id] = d
     elif d[1] != xml_text:
         raise ConfigError(f"domain {domain_id} already runs with another configuration")
     return d[0]
+
+
+def _create_domain(Domain, domain_id, xml_text, where):
+    """Domain(); a configuration Cyclone refuses is a ConfigError carrying Cyclone's reason
+    (which Cyclone prints on stderr: caught there, so the user reads one line)."""
+    from cyclonedds.core import DDSException
+
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as said:
+        os.dup2(said.fileno(), 2)
+        try:
+            made = Domain(domain_id, xml_text)
+            failed = False
+        except DDSException:
+            failed = True
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        said.seek(0)
+        text = said.read().decode(errors="replace")
+    if failed:
+        reason = "; ".join(" ".join(ln.split()[2:]) if ln.split()[:1] and
+                           ln.split()[0][:1].isdigit() else ln.strip()
+                           for ln in text.splitlines() if ln.strip())
+        raise ConfigError(f"{where}: Cyclone DDS refused the configuration"
+                          + (f" ({reason})" if reason else ""))
+    # Warnings of an accepted configuration still reach the user.
+    sys.stderr.write(text)
+    return made
 
 
 _clients = []

@@ -320,11 +320,17 @@ static int write_image(struct co_storage *st, uint32_t save_mask, uint32_t drop_
 
 int co_storage_save(struct co_storage *st, uint32_t group_mask)
 {
+	if (st->absent) {
+		return -ENODEV;
+	}
 	return write_image(st, group_mask & CO_OD_GROUP_ALL, 0);
 }
 
 int co_storage_clear(struct co_storage *st, uint32_t group_mask)
 {
+	if (st->absent) {
+		return -ENODEV;
+	}
 	return write_image(st, 0, group_mask & CO_OD_GROUP_ALL);
 }
 
@@ -457,19 +463,103 @@ static uint32_t storage_validate(struct co_od *od, struct co_od_req *req, void *
 	uint32_t v = (uint32_t)co_od_req_uint(req);
 	bool save = req->info->index == 0x1010U;
 
-	if (mask == 0U || req->len != 4U ||
+	if (st->own_write) {
+		return 0U;
+	}
+	/* CiA 301 §7.5.2.13-14: a wrong signature is refused with 0800002xh; 20h: cannot be
+	 * stored, 21h: local control. Without medium nothing can be stored, signature or not. */
+	if (mask == 0U || req->len != 4U || st->absent ||
 	    v != (save ? CO_STORAGE_SIGNATURE_SAVE : CO_STORAGE_SIGNATURE_LOAD)) {
 		return CO_SDO_AB_DATA_XFER;
+	}
+	if (st->locked) {
+		return CO_SDO_AB_DATA_LOC_CTRL;
 	}
 	int err = save ? co_storage_save(st, mask) : co_storage_clear(st, mask);
 
 	return err == 0 ? CO_OD_HANDLED : CO_SDO_AB_HW;
 }
 
+/* Without medium, 1010h/1011h sub 1.. read 0: "does not save", "does not restore". */
+static int claim_nothing(struct co_storage *st)
+{
+	static const uint8_t zero[4];
+	int err = 0;
+
+	st->own_write = true;
+	for (uint16_t index = 0x1010U; index <= 0x1011U; index++) {
+		uint8_t highest = 0U;
+
+		if (co_od_get_u8(st->od, index, 0, &highest) != 0U) {
+			continue;
+		}
+		for (uint16_t sub = 1U; sub <= highest; sub++) {
+			struct co_od_info info;
+
+			if (co_od_find(st->od, index, (uint8_t)sub, &info) == 0U &&
+			    co_od_write(st->od, index, (uint8_t)sub, zero,
+					info.size < 4U ? info.size : 4U, CO_OD_WRITER_APP) != 0U) {
+				err = -EROFS;
+			}
+		}
+	}
+	st->own_write = false;
+	return err;
+}
+
 static void storage_restore_cb(struct co_od *od, uint32_t group_mask, void *user_data)
 {
+	struct co_storage *st = user_data;
+
 	(void)od;
-	(void)co_storage_restore(user_data, group_mask);
+	if (st->absent) {
+		/* The reset loaded the EDS values again. */
+		if ((group_mask & CO_OD_GROUP_BIT(CO_OD_GROUP_COMM)) != 0U) {
+			(void)claim_nothing(st);
+		}
+		return;
+	}
+	(void)co_storage_restore(st, group_mask);
+}
+
+static int attach(struct co_storage *st)
+{
+	const struct co_od_hook hook = {
+		.index_first = 0x1010,
+		.index_last = 0x1011,
+		.sub_first = 1,
+		.sub_last = 0xFF,
+		.validate = storage_validate,
+		.user_data = st,
+	};
+	int err;
+
+	(void)co_od_hook_unregister(st->od, st);
+	err = co_od_hook_register(st->od, &hook);
+	if (err != 0) {
+		return err;
+	}
+	return co_od_set_restore_cb(st->od, storage_restore_cb, st);
+}
+
+int co_storage_init_absent(struct co_storage *st, struct co_od *od)
+{
+	int err;
+
+	if (st == NULL || od == NULL) {
+		return -EINVAL;
+	}
+	(void)memset(st, 0, sizeof(*st));
+	st->od = od;
+	st->active = -1;
+	st->absent = true;
+	err = attach(st);
+	return err != 0 ? err : claim_nothing(st);
+}
+
+void co_storage_set_locked(struct co_storage *st, bool locked)
+{
+	st->locked = locked;
 }
 
 int co_storage_init(struct co_storage *st, struct co_od *od, const struct co_storage_backend *be)
@@ -489,19 +579,5 @@ int co_storage_init(struct co_storage *st, struct co_od *od, const struct co_sto
 	if (err != 0) {
 		return err;
 	}
-	const struct co_od_hook hook = {
-		.index_first = 0x1010,
-		.index_last = 0x1011,
-		.sub_first = 1,
-		.sub_last = 0xFF,
-		.validate = storage_validate,
-		.user_data = st,
-	};
-
-	(void)co_od_hook_unregister(od, st);
-	err = co_od_hook_register(od, &hook);
-	if (err != 0) {
-		return err;
-	}
-	return co_od_set_restore_cb(od, storage_restore_cb, st);
+	return attach(st);
 }

@@ -99,6 +99,6 @@ void fz_check_state(void);
 void fz_line_init(void);
 
 extern const struct fz_harness fz_nmt, fz_errctl, fz_sdo_server, fz_pdo, fz_sync, fz_time, fz_emcy,
-	fz_sdo_client, fz_mgr, fz_lss, fz_srdo, fz_cdcf;
+	fz_sdo_client, fz_mgr, fz_lss, fz_srdo, fz_cdcf, fz_dcf;
 
 #endif /* SAFELINE_TESTS_FUZZ_FUZZ_H_ */

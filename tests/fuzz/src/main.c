@@ -26,8 +26,8 @@ int LLVMFuzzerRunDriver(int *argc, char ***argv, int (*cb)(const uint8_t *data, 
 struct fz_state fz;
 
 static const struct fz_harness *const harnesses[] = {
-	&fz_nmt,  &fz_errctl,     &fz_sdo_server, &fz_pdo, &fz_sync, &fz_time,
-	&fz_emcy, &fz_sdo_client, &fz_mgr,        &fz_lss, &fz_srdo, &fz_cdcf,
+	&fz_nmt,        &fz_errctl, &fz_sdo_server, &fz_pdo,  &fz_sync, &fz_time, &fz_emcy,
+	&fz_sdo_client, &fz_mgr,    &fz_lss,        &fz_srdo, &fz_cdcf, &fz_dcf,
 };
 
 void fz_fail(const char *fmt, ...)

@@ -28,8 +28,10 @@ def network_dcf(tmp_path):
     # vendor FFh, product 1, revision 1.
     od = canopen.import_od(str(EDS), GOOD)
     ident = [od[0x1018][s].default for s in (1, 2, 3)]
-    lines = ["[DeviceComissioning]", "NodeID=0x01", "", "[1F80]", "ParameterValue=0x00000001",
-             "", "[1F89]", "ParameterValue=5000", ""]
+    # CiA 306's mandatory objects first: the manager reads a DCF with scripts/eds2od's rules.
+    lines = ["[1000]", "ParameterValue=0", "", "[1001]", "ParameterValue=0", "", "[1018]",
+             "SubNumber=1", "", "[DeviceComissioning]", "NodeID=0x01", "", "[1F80]",
+             "ParameterValue=0x00000001", "", "[1F89]", "ParameterValue=5000", ""]
     for index, values in (("1F81", {GOOD: 0x0D, STUCK: 0x05}),
                           ("1F84", {n: od[0x1000].default for n in (GOOD, STUCK)}),
                           ("1F85", {n: ident[0] for n in (GOOD, STUCK)}),
@@ -40,7 +42,8 @@ def network_dcf(tmp_path):
         lines += [f"0x{n:X}=0x{v:08X}" for n, v in values.items()] + [""]
     lines += ["[1016]", "SubNumber=9", "", "[1016sub1]", f"ParameterValue=0x00{GOOD:02X}012C",
               "", "[1016sub2]", f"ParameterValue=0x00{STUCK:02X}012C", ""]
-    lines += [f"[1F22sub{GOOD:X}]", "DataType=0x000F", "UploadFile=e35.bin", ""]
+    lines += ["[1F22]", "ObjectType=0x8", "SubNumber=128", "",
+              f"[1F22sub{GOOD:X}]", "DataType=0x000F", "UploadFile=e35.bin", ""]
     # The concise DCF: heartbeat 100 ms, modes of operation (6060h, INTEGER8) = 3.
     cdcf = struct.pack("<I", 2)
     cdcf += struct.pack("<HBIH", 0x1017, 0, 2, 100)

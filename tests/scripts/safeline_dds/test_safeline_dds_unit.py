@@ -222,6 +222,44 @@ def test_without_the_loopback_configuration_the_client_refuses(tmp_path, monkeyp
         config.load(str(tmp_path / "nope.xml"))
 
 
+@pytest.mark.parametrize("content,reason", [
+    ("vm\n", "not a Cyclone DDS configuration: not XML (syntax error: line 1, column 0)"),
+    ("", "not a Cyclone DDS configuration: not XML"),
+    ("<Domain/>", "the root element is <Domain>, not <CycloneDDS>"),
+    ("<CycloneDDS>\u00e9</CycloneDDS>", "Cyclone takes ASCII only"),
+    (b"\xff\xfe<", "not UTF-8 text (byte 0)"),
+])
+def test_a_file_that_is_no_dds_configuration_is_refused_in_one_line(tmp_path, content, reason):
+    bad = tmp_path / "hostname"
+    if isinstance(content, bytes):
+        bad.write_bytes(content)
+    else:
+        bad.write_text(content)
+    with pytest.raises(config.ConfigError) as e:
+        config.load(str(bad))
+    assert str(e.value).startswith(f"{bad}: ") and reason in str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_a_fifo_or_a_directory_as_dds_configuration_is_refused_without_blocking(tmp_path):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    for path in (fifo, tmp_path):
+        with pytest.raises(config.ConfigError, match="not a regular file"):
+            config.load(str(path))
+
+
+def test_dds_config_of_a_plain_text_file_ends_in_one_line_without_traceback(tmp_path):
+    """safeline-dds --dds-config /etc/hostname: a usage error in one line, before any DDS."""
+    host = tmp_path / "hostname"
+    host.write_text("vm\n")
+    r = subprocess.run([sys.executable, SCRIPT, "--dds-config", str(host), "nodes"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == cli.EXIT_USAGE
+    assert r.stderr == (f"safeline-dds: error: {host}: not a Cyclone DDS configuration: not XML "
+                        "(syntax error: line 1, column 0)\n")
+
+
 def test_client_id_carries_the_name_the_allow_list_matches(monkeypatch):
     monkeypatch.setenv("SAFELINE_DDS_CLIENT", "ops")
     cid = config.client_id()
@@ -544,6 +582,18 @@ def test_cyclonedds_uri_is_ignored(tmp_path):
     r = netns_run([sys.executable, SCRIPT, "--timeout", "0.3", "nodes"], env=env)
     assert r.returncode == cli.EXIT_NO_BRIDGE, r.stderr
     assert "nosuch0" not in r.stderr
+
+
+def test_a_configuration_cyclone_refuses_is_one_line_with_its_reason(tmp_path):
+    bad = tmp_path / "bad.xml"
+    bad.write_text('<CycloneDDS xmlns="https://cdds.io/config"><Domain Id="any"><General>'
+                   '<Frobnicate>1</Frobnicate></General></Domain></CycloneDDS>')
+    r = netns_run([sys.executable, SCRIPT, "--dds-config", str(bad), "nodes"])
+    assert r.returncode == cli.EXIT_USAGE, r.stderr
+    assert "Traceback" not in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr
+    assert r.stderr.startswith(f"safeline-dds: error: {bad}: Cyclone DDS refused the "
+                               "configuration (")
+    assert "Frobnicate: unknown element" in r.stderr
 
 
 def test_help_lists_every_command():

@@ -8,6 +8,10 @@
  * an uptime counter (2000h) that the application updates every second, a setpoint (2001h)
  * and a 128 KiB data buffer (2100h, DOMAIN) served by an object provider.
  *
+ * Parameters are stored (1010h "save", 1011h "load") in the file --storage=FILE names; without
+ * it the node has no medium and says so: 1010h/1011h read 0 and requests are refused with
+ * 08000020h.
+ *
  * The line is can_socketcan0 when it has an interface (--can-if=0:vcan0), else can_virtual0.
  */
 
@@ -20,8 +24,11 @@
 
 #include <canopen/line.h>
 #include <canopen/node.h>
+#include <canopen/storage.h>
 
+#include "cmdline.h"
 #include "hello_node_od.h"
+#include "posix_native_task.h"
 #include "sample_common.h"
 
 LOG_MODULE_REGISTER(hello_node, LOG_LEVEL_INF);
@@ -30,11 +37,60 @@ LOG_MODULE_REGISTER(hello_node, LOG_LEVEL_INF);
 #define DATA_CAPACITY (128U * 1024U)
 
 #define DEFAULT_NODE_ID 0x10U
+/* Two image slots of the storage module, each holding every stored value of the dictionary. */
+#define STORAGE_SIZE    8192U
 
 static struct co_line line;
 static struct co_node node;
 static struct hello_node_od_ram od_ram;
 static K_THREAD_STACK_DEFINE(line_stack, CONFIG_CANOPEN_LINE_STACK_SIZE);
+static struct co_storage storage;
+static struct co_storage_file medium;
+static char *storage_arg;
+
+static void add_options(void)
+{
+	static struct args_struct_t opts[] = {
+		{
+			.option = "storage",
+			.name = "path",
+			.type = 's',
+			.dest = &storage_arg,
+			.descript = "parameter storage medium (1010h/1011h), created if missing; "
+				    "without it the node does not store parameters",
+		},
+		ARG_TABLE_ENDMARKER,
+	};
+
+	native_add_command_line_opts(opts);
+}
+NATIVE_TASK(add_options, PRE_BOOT_1, 21);
+
+/* Before the start, so that the first reset restores what is stored. */
+static int attach_storage(void)
+{
+	int err;
+
+	if (storage_arg == NULL) {
+		printk("hello_node: no storage medium (--storage=FILE): 1010h/1011h read 0\n");
+		co_node_lock(&node);
+		err = co_storage_init_absent(&storage, co_node_od(&node));
+		co_node_unlock(&node);
+		return err;
+	}
+	err = co_storage_file_open(&medium, storage_arg, STORAGE_SIZE);
+	if (err == 0) {
+		co_node_lock(&node);
+		err = co_storage_init(&storage, co_node_od(&node), &medium.be);
+		co_node_unlock(&node);
+	}
+	if (err != 0) {
+		LOG_ERR("storage medium %s unusable (%d)", storage_arg, err);
+		return err;
+	}
+	printk("hello_node: parameters stored in %s\n", storage_arg);
+	return 0;
+}
 
 /*
  * 2100h: a DOMAIN larger than any staging buffer. Chunks stream into a shadow buffer that
@@ -136,6 +192,9 @@ int main(void)
 	}
 	if (err == 0) {
 		err = co_od_provider_register(co_node_od(&node), &data_provider);
+	}
+	if (err == 0) {
+		err = attach_storage();
 	}
 	if (err == 0) {
 		err = co_line_start(&line, line_stack, K_THREAD_STACK_SIZEOF(line_stack),

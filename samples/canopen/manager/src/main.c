@@ -71,6 +71,7 @@ static bool dds_arg;
 static char *dds_config_arg;
 static char *dds_allow_arg;
 static uint32_t dds_domain_arg = CO_BRIDGE_DDS_DOMAIN_DEFAULT;
+static char *dds_domain_text;
 
 static void slaves_found(char *argv, int offset)
 {
@@ -95,6 +96,7 @@ static void dds_found(char *argv, int offset)
 static void dds_domain_found(char *argv, int offset)
 {
 	dds_domain_arg = (uint32_t)cmd_read_uint_option("dds-domain", &argv[offset], 0U, 232U);
+	dds_domain_text = &argv[offset];
 }
 
 static void add_options(void)
@@ -245,6 +247,16 @@ static void check_options(void)
 	uint32_t ab;
 	int id;
 
+	/* These only configure the bridge: without it they would be silently ignored. */
+	if (!dds_arg && dds_allow_arg != NULL) {
+		cmd_option_error("dds-allow", dds_allow_arg, "needs --dds (the DDS bridge)");
+	}
+	if (!dds_arg && dds_config_arg != NULL) {
+		cmd_option_error("dds-config", dds_config_arg, "needs --dds (the DDS bridge)");
+	}
+	if (!dds_arg && dds_domain_text != NULL) {
+		cmd_option_error("dds-domain", dds_domain_text, "needs --dds (the DDS bridge)");
+	}
 	if (network_load(&net, path, err, sizeof(err)) != 0) {
 		cmd_option_error("dcf", path, "%s", err);
 	}
@@ -255,12 +267,16 @@ static void check_options(void)
 		(void)snprintf(err, sizeof(err), "%d", id);
 		cmd_option_error(sample_node_id(0) != 0 ? "node-id" : "dcf",
 				 sample_node_id(0) != 0 ? err : path,
-				 "node %d is a slave of the network (1F81h assigns %s)", id, list);
+				 "%s:%u: node %d is a slave of the network (1F81h assigns %s)",
+				 path, network_slave_line(&net, manager_id), id, list);
 	}
 	if (net.n_slaves > CONFIG_CANOPEN_MGR_SLAVES) {
+		/* The line of the first slave that finds no slot. */
 		cmd_option_error("dcf", path,
-				 "1F81h assigns %u slaves (%s); the manager has %d slave slots "
-				 "(CONFIG_CANOPEN_MGR_SLAVES)",
+				 "%s:%u: 1F81h assigns %u slaves (%s); the manager has %d slave "
+				 "slots (CONFIG_CANOPEN_MGR_SLAVES)",
+				 path,
+				 network_slave_line(&net, net.slaves[CONFIG_CANOPEN_MGR_SLAVES]),
 				 net.n_slaves, list, CONFIG_CANOPEN_MGR_SLAVES);
 	}
 	if (co_od_init(&scratch, &manager_od_def, &scratch_ram, manager_id) != 0) {

@@ -51,6 +51,12 @@ struct network {
  */
 int network_load(struct network *net, const char *path, char *err, size_t errlen);
 
+/* Free the concise DCFs network_load() read. */
+void network_free(struct network *net);
+
+/* Line of the DCF that assigns slave @p id (1F81h), 0 if none. */
+uint32_t network_slave_line(const struct network *net, uint8_t id);
+
 /*
  * Write the network's values into @p od (writer CO_OD_WRITER_STORAGE, caller holds the
  * dictionary's lock if it has one). Returns 0, or the first SDO abort code with the value

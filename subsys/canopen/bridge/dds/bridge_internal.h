@@ -94,7 +94,7 @@ struct br_rule {
 	bool nmt;
 	/* -1: any line */
 	int16_t line_no;
-	/* Nodes 1..127, bit 0: broadcast (NMT "all"). */
+	/* Nodes 1..127 (bit 0 unused). */
 	uint32_t nodes[4];
 	bool any_object;
 	uint8_t n_objects;
@@ -146,9 +146,15 @@ void br_conf_free(struct br_conf *c);
 const struct br_eds *br_conf_eds(const struct br_conf *c, uint8_t line_no, uint8_t node_id);
 /* The name part of a client id ("name@host:pid" -> "name"), into @p buf. */
 void br_client_name(const char *client_id, char *buf, size_t len);
+/* A write of an object whose sub-index 80h means every node (1F25h, 1F82h, 1F83h) is allowed
+ * only when the write of each sub-index 01h..7Fh is. */
 bool br_allow_write(const struct br_conf *c, const char *client, uint8_t line_no, uint8_t node_id,
 		    uint16_t index, uint8_t sub);
-/* @p node_id 0: broadcast. @p cmd: BR_CMD_* bit. */
+#define BR_SUB_ALL_NODES 0x80U
+/* CiA 302-2's "all nodes" sub-index of a request object. */
+bool br_allow_is_for_all_nodes(uint16_t index, uint8_t sub);
+/* @p node_id 0: broadcast, allowed only when @p cmd is allowed for each node 1..127. @p cmd:
+ * BR_CMD_* bit. */
 bool br_allow_nmt(const struct br_conf *c, const char *client, uint8_t line_no, uint8_t node_id,
 		  uint8_t cmd);
 /* BR_CMD_* bit of an NMT command specifier, 0 if unknown. */

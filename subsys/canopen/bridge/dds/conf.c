@@ -14,10 +14,12 @@
  * Allow-list (without it: read-only):
  *   write CLIENT LINE NODES OBJECTS    CLIENT (a glob on the client's name) may write OBJECTS
  *   nmt   CLIENT LINE NODES COMMANDS   ... and send COMMANDS to NODES
- * LINE: a number or *. NODES: *, or a comma list of N and N-M (1..127); "all" is the NMT
- * broadcast (node 0), which * includes. OBJECTS: *, or a comma list of IIII (every sub-index),
- * IIII:SS and IIII-JJJJ. COMMANDS: *, or a comma list of start, stop, preop, reset,
- * reset-comm.
+ * LINE: a number or *. NODES: *, or a comma list of N and N-M (1..127). OBJECTS: *, or a
+ * comma list of IIII (every sub-index), IIII:SS and IIII-JJJJ. COMMANDS: *, or a comma list of
+ * start, stop, preop, reset, reset-comm.
+ * A request for every node (NMT node 0; sub-index 80h of 1F25h, 1F82h, 1F83h, CiA 302-2) is
+ * allowed only when the same request is allowed for each node 1..127: a broadcast reaches the
+ * manager and nodes nobody listed as well.
  */
 
 #include <ctype.h>
@@ -149,14 +151,14 @@ static bool test_bit(const uint32_t bits[4], unsigned int n)
 	return (bits[n / 32U] & BIT(n % 32U)) != 0U;
 }
 
-/* NODES into a bitmap (bit 0: broadcast, allowed only with @p nmt). */
-static int parse_nodes(const struct ctx *c, char *s, bool nmt, uint32_t bits[4])
+/* NODES (1..127) into a bitmap. */
+static int parse_nodes(const struct ctx *c, char *s, uint32_t bits[4])
 {
 	char *save = NULL;
 
 	memset(bits, 0, 4 * sizeof(bits[0]));
 	if (strcmp(s, "*") == 0) {
-		for (unsigned int n = nmt ? 0U : 1U; n < BR_NODE_IDS; n++) {
+		for (unsigned int n = 1U; n < BR_NODE_IDS; n++) {
 			set_bit(bits, n);
 		}
 		return 0;
@@ -167,11 +169,9 @@ static int parse_nodes(const struct ctx *c, char *s, bool nmt, uint32_t bits[4])
 		unsigned long b;
 
 		if (strcmp(tok, "all") == 0) {
-			if (!nmt) {
-				return fail(c, "'all' (the NMT broadcast) is for nmt rules");
-			}
-			set_bit(bits, 0U);
-			continue;
+			/* A rule for "all" alone would let a broadcast reach unlisted nodes. */
+			return fail(c, "'all' names no node: a request for all nodes is allowed "
+				       "where each node 1..127 is (NODES *)");
 		}
 		if (dash != NULL) {
 			*dash = '\0';
@@ -287,7 +287,7 @@ static int eds_line(struct br_conf *conf, const struct ctx *c, char **w, int n)
 	}
 	err = parse_line_no(c, w[1], false, &line_no);
 	if (err == 0) {
-		err = parse_nodes(c, w[2], false, bits);
+		err = parse_nodes(c, w[2], bits);
 	}
 	if (err != 0) {
 		return err;
@@ -400,7 +400,7 @@ static int rule_line(struct br_conf *conf, const struct ctx *c, char **w, int n)
 	(void)strcpy(r->client, w[1]);
 	err = parse_line_no(c, w[2], true, &r->line_no);
 	if (err == 0) {
-		err = parse_nodes(c, w[3], nmt, r->nodes);
+		err = parse_nodes(c, w[3], r->nodes);
 	}
 	if (err == 0) {
 		err = nmt ? parse_cmds(c, w[4], &r->cmds) : parse_objects(c, w[4], r);
@@ -512,12 +512,9 @@ static bool rule_matches(const struct br_rule *r, bool nmt, const char *client, 
 	       fnmatch(r->client, client, 0) == 0;
 }
 
-bool br_allow_write(const struct br_conf *conf, const char *client, uint8_t line_no,
-		    uint8_t node_id, uint16_t index, uint8_t sub)
+static bool write_allowed(const struct br_conf *conf, const char *client, uint8_t line_no,
+			  uint8_t node_id, uint16_t index, uint8_t sub)
 {
-	if (!conf->allow || node_id == 0U) {
-		return false;
-	}
 	for (int i = 0; i < conf->n_rules; i++) {
 		const struct br_rule *r = &conf->rules[i];
 
@@ -539,12 +536,33 @@ bool br_allow_write(const struct br_conf *conf, const char *client, uint8_t line
 	return false;
 }
 
-bool br_allow_nmt(const struct br_conf *conf, const char *client, uint8_t line_no, uint8_t node_id,
-		  uint8_t cmd)
+bool br_allow_is_for_all_nodes(uint16_t index, uint8_t sub)
 {
-	if (!conf->allow || cmd == 0U) {
+	/* CiA 302-2: configuration request, request NMT, request node guarding. */
+	return sub == BR_SUB_ALL_NODES &&
+	       (index == 0x1F25U || index == 0x1F82U || index == 0x1F83U);
+}
+
+bool br_allow_write(const struct br_conf *conf, const char *client, uint8_t line_no,
+		    uint8_t node_id, uint16_t index, uint8_t sub)
+{
+	if (!conf->allow || node_id == 0U ||
+	    !write_allowed(conf, client, line_no, node_id, index, sub)) {
 		return false;
 	}
+	if (br_allow_is_for_all_nodes(index, sub)) {
+		for (uint8_t n = 1U; n < BR_NODE_IDS; n++) {
+			if (!write_allowed(conf, client, line_no, node_id, index, n)) {
+				return false;
+			}
+		}
+	}
+	return true;
+}
+
+static bool nmt_allowed(const struct br_conf *conf, const char *client, uint8_t line_no,
+			uint8_t node_id, uint8_t cmd)
+{
 	for (int i = 0; i < conf->n_rules; i++) {
 		const struct br_rule *r = &conf->rules[i];
 
@@ -553,6 +571,24 @@ bool br_allow_nmt(const struct br_conf *conf, const char *client, uint8_t line_n
 		}
 	}
 	return false;
+}
+
+bool br_allow_nmt(const struct br_conf *conf, const char *client, uint8_t line_no, uint8_t node_id,
+		  uint8_t cmd)
+{
+	if (!conf->allow || cmd == 0U) {
+		return false;
+	}
+	if (node_id != 0U) {
+		return nmt_allowed(conf, client, line_no, node_id, cmd);
+	}
+	/* The broadcast: every node, the manager's own included. */
+	for (uint8_t n = 1U; n < BR_NODE_IDS; n++) {
+		if (!nmt_allowed(conf, client, line_no, n, cmd)) {
+			return false;
+		}
+	}
+	return true;
 }
 
 uint8_t br_cmd_bit(uint8_t cs)

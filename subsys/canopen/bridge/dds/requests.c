@@ -366,10 +366,21 @@ static void handle_sdo(const safeline_canopen_v1_SdoRequest *rq, dds_instance_ha
 			   "node %u is unknown on line %u", rq->node_id, rq->line);
 	} else if (write && !br_allow_write(&br.conf, client, rq->line, rq->node_id, rq->index,
 					    rq->subindex)) {
+		char why[24] = "";
+
+		if (br.conf.allow && br_allow_is_for_all_nodes(rq->index, rq->subindex)) {
+			uint8_t n = 1U;
+
+			while (n < 127U && br_allow_write(&br.conf, client, rq->line, rq->node_id,
+							  rq->index, n)) {
+				n++;
+			}
+			(void)snprintf(why, sizeof(why), " (not %04Xh:%02X)", rq->index, n);
+		}
 		set_result(&r, safeline_canopen_v1_STATUS_REFUSED,
-			   "%s: client '%s' may not write %04Xh:%02X of node %u on line %u",
+			   "%s: client '%s' may not write %04Xh:%02X of node %u on line %u%s",
 			   br.conf.allow ? "not in the allow-list" : "the bridge is read-only",
-			   client, rq->index, rq->subindex, rq->node_id, rq->line);
+			   client, rq->index, rq->subindex, rq->node_id, rq->line, why);
 		(void)atomic_inc(&br.refused);
 	} else {
 		bool described = describe(slot, rq->line, rq->node_id, rq->index, rq->subindex, &r);
@@ -500,10 +511,18 @@ static void handle_nmt(const safeline_canopen_v1_NmtRequest *rq, dds_instance_ha
 		(void)snprintf(msg, sizeof(msg), "node %u is unknown on line %u", rq->node_id,
 			       rq->line);
 	} else if (!br_allow_nmt(&br.conf, client, rq->line, rq->node_id, bit)) {
-		char target[16] = "all nodes";
+		char target[40] = "all nodes";
 
 		if (rq->node_id != 0U) {
 			(void)snprintf(target, sizeof(target), "node %u", rq->node_id);
+		} else if (br.conf.allow) {
+			/* The broadcast reaches every node: name the first one not allowed. */
+			uint8_t n = 1U;
+
+			while (n < 127U && br_allow_nmt(&br.conf, client, rq->line, n, bit)) {
+				n++;
+			}
+			(void)snprintf(target, sizeof(target), "all nodes (not to node %u)", n);
 		}
 		status = safeline_canopen_v1_STATUS_REFUSED;
 		(void)snprintf(msg, sizeof(msg), "%s: client '%s' may not send %s to %s on line %u",

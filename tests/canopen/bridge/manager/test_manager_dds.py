@@ -22,8 +22,8 @@ import pytest
 from bridge_fixtures import BASE, ISOLATED, NETNS, SCRIPT
 from safeline_dds import testing
 from safeline_dds import types as T
-from safeline_dds.client import (NMT_PREOP, NMT_START, NMT_STOP, QOS_EMCY, QOS_RPC,
-                                 QOS_STATE, RequestTimeout)
+from safeline_dds.client import (NMT_PREOP, NMT_RESET, NMT_START, NMT_STOP, QOS_EMCY,
+                                 QOS_RPC, QOS_STATE, RequestTimeout)
 
 QUIET = ("--cut=0", "--cycle=0")  # the network without the demo's power cycle and cut
 
@@ -214,6 +214,14 @@ def test_allow_list_refusals_change_nothing(firmware, client, cli):
     time.sleep(0.3)
     assert nodes_of(c)[(0, 1)].nmt_state == 5, "the manager stays OPERATIONAL"
     until(lambda: c.wait_bridge(1).refused == 4, 3, "four refusals counted")
+    # A broadcast reaches the manager as well: refused, since node 1 may not be commanded.
+    for cmd in (NMT_STOP, NMT_PREOP, NMT_RESET, NMT_START):
+        r = c.nmt(0, cmd)
+        assert r.status == T.STATUS_REFUSED, r.message
+        assert "to all nodes (not to node 1) on line 0" in r.message, r.message
+    time.sleep(0.3)
+    assert all(n.nmt_state == 5 for n in c.nodes() if n.node_id != 5), "nobody moved"
+    until(lambda: c.wait_bridge(1).refused == 8, 3, "eight refusals counted")
     # The allowed ones (demo allow-list: 1017h, 2001h, 2100h of 2..5) go through.
     assert c.sdo_write(2, 0x2001, 0, b"\x58\x02").status == T.STATUS_OK
     rc, doc, err = cli("write", 1, "1017", 0, 1000)
@@ -240,6 +248,38 @@ def test_custom_allow_list_by_client_name(firmware, client, tmp_path):
     assert ops.nmt(4, NMT_START).status == T.STATUS_OK
 
 
+def test_a_request_for_all_nodes_needs_every_node_allowed(firmware, client, cli, tmp_path):
+    """NMT "all" and the manager's request objects' sub-index 80h (1F82h request NMT, 1F83h
+    request guarding) reach every node: allowed only where each node is."""
+    allow = tmp_path / "allow.conf"
+    allow.write_text("nmt    ops  0  2-127  stop,start\n"
+                     "nmt    ops  0  1      start\n"
+                     "write  ops  0  1      1F82:02,1F82:80,1F83:80\n")
+    fw, ops = start_settled(firmware, client, *QUIET, f"--dds-allow={allow}", name="ops")
+    r = ops.nmt(0, NMT_STOP)
+    assert r.status == T.STATUS_REFUSED, r.message
+    assert r.message == ("not in the allow-list: client 'ops' may not send stop to all nodes "
+                         "(not to node 1) on line 0"), r.message
+    rc, doc, err = cli("nmt", "stop", "all", client="ops")
+    assert rc == 1 and doc["status"] == "refused" and "(not to node 1)" in doc["error"], err
+    for index in (0x1F82, 0x1F83):
+        r = ops.sdo_write(1, index, 0x80, b"\x04")
+        assert r.status == T.STATUS_REFUSED, r.message
+        assert f"may not write {index:04X}h:80 of node 1 on line 0 (not {index:04X}h:01)" \
+            in r.message, r.message
+    time.sleep(0.3)
+    n = nodes_of(ops)
+    assert n[(0, 1)].nmt_state == 5 and all(n[(0, i)].nmt_state == 5 for i in (2, 3, 4)), \
+        "nobody stopped"
+    # One node through the manager's 1F82h: only that node.
+    assert ops.sdo_write(1, 0x1F82, 0x02, b"\x04").status == T.STATUS_OK
+    until(lambda: nodes_of(ops)[(0, 2)].nmt_state == 4, 5, "node 2 STOPPED")
+    # start is allowed for every node: the broadcast goes out, the manager included.
+    r = ops.nmt(0, NMT_START)
+    assert r.status == T.STATUS_OK, r.message
+    until(lambda: nodes_of(ops)[(0, 2)].nmt_state == 5, 5, "node 2 OPERATIONAL again")
+
+
 def test_without_allow_list_the_bridge_is_read_only(firmware, client):
     fw, c = start_settled(firmware, client, *QUIET, "--dds-allow=none")
     assert c.wait_bridge(1).read_only
@@ -253,11 +293,12 @@ def test_without_allow_list_the_bridge_is_read_only(firmware, client):
 
 def test_a_bad_allow_list_stops_the_firmware(firmware, tmp_path):
     allow = tmp_path / "bad.conf"
-    allow.write_text("# fine\nwrite ops 0 all 2001\n")
+    allow.write_text("# fine\nnmt ops 0 2-5,all stop\n")
     fw = firmware(f"--dds-allow={allow}")
     assert fw.proc.wait(15) == 1
     text = fw.text()
-    assert f"{allow}:2: 'all' (the NMT broadcast) is for nmt rules" in text
+    assert f"{allow}:2: 'all' names no node: a request for all nodes is allowed where each " \
+        "node 1..127 is (NODES *)" in text
     assert "DDS bridge failed to start (-22)" in text
 
 
@@ -336,8 +377,9 @@ def test_nmt_commands_show_on_node_state(firmware, client, cli):
     rc, doc, err = cli("nmt", "preop", 2)
     assert rc == 0, err
     until(lambda: nodes_of(c)[(0, 2)].nmt_state == 127, 5, "node 2 PRE-OPERATIONAL")
-    rc, doc, err = cli("nmt", "start", "all")
-    assert rc == 0, err
+    for node in (2, 4, 5):
+        rc, doc, err = cli("nmt", "start", node)
+        assert rc == 0, err
     until(lambda: all(nodes_of(c)[(0, i)].nmt_state == 5 for i in (1, 2, 3, 4, 5)), 5,
           "everybody OPERATIONAL")
     boots = nodes_of(c)[(0, 3)].heartbeat_ns

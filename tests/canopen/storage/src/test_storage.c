@@ -313,6 +313,91 @@ ZTEST(storage, test_backend_failure_is_a_hardware_abort)
 	zassert_equal(hb, 100);
 }
 
+/* CiA 301 §7.5.2.13-14: anything but the signature is refused with 08000020h, on every
+ * sub-index of both objects, and nothing is stored. */
+ZTEST(storage, test_a_wrong_signature_is_refused_with_08000020h)
+{
+	uint16_t hb;
+	uint32_t v;
+
+	boot(&d1, &ram_be.be, 5);
+	set_generation(&d1, 1);
+	for (uint8_t sub = 1; sub <= 4; sub++) {
+		zassert_equal(sdo_u32(&d1, 0x1010, sub, 5), CO_SDO_AB_DATA_XFER);
+		zassert_equal(sdo_u32(&d1, 0x1010, sub, CO_STORAGE_SIGNATURE_LOAD),
+			      CO_SDO_AB_DATA_XFER);
+		zassert_equal(sdo_u32(&d1, 0x1011, sub, 5), CO_SDO_AB_DATA_XFER);
+		zassert_equal(sdo_u32(&d1, 0x1011, sub, CO_STORAGE_SIGNATURE_SAVE),
+			      CO_SDO_AB_DATA_XFER);
+		zassert_ok(co_od_get_u32(&d1.od, 0x1010, sub, &v));
+		zassert_equal(v, 1, "still 'saves on command'");
+		zassert_ok(co_od_get_u32(&d1.od, 0x1011, sub, &v));
+		zassert_equal(v, 1, "still 'restores defaults'");
+	}
+	boot(&d2, &ram_be.be, 5);
+	zassert_ok(co_od_get_u16(&d2.od, 0x1017, 0, &hb));
+	zassert_equal(hb, 0, "nothing was stored");
+}
+
+/* A node without medium says so: 1010h/1011h read 0, at every reset too, and a save or a
+ * restore is refused with 08000020h, with the right signature as well. */
+ZTEST(storage, test_a_node_without_medium_says_so)
+{
+	uint32_t v;
+
+	memset(&d1, 0, sizeof(d1));
+	zassert_ok(co_od_init(&d1.od, &st_od_def, &d1.ram, 5));
+	zassert_ok(co_storage_init_absent(&d1.st, &d1.od));
+	for (int boot_no = 0; boot_no < 2; boot_no++) {
+		co_od_reset_app(&d1.od);
+		co_od_reset_comm(&d1.od);
+		for (uint8_t sub = 1; sub <= 4; sub++) {
+			zassert_ok(co_od_get_u32(&d1.od, 0x1010, sub, &v));
+			zassert_equal(v, 0, "1010h:%u does not save", sub);
+			zassert_ok(co_od_get_u32(&d1.od, 0x1011, sub, &v));
+			zassert_equal(v, 0, "1011h:%u does not restore", sub);
+			zassert_equal(sdo_u32(&d1, 0x1010, sub, CO_STORAGE_SIGNATURE_SAVE),
+				      CO_SDO_AB_DATA_XFER);
+			zassert_equal(sdo_u32(&d1, 0x1011, sub, CO_STORAGE_SIGNATURE_LOAD),
+				      CO_SDO_AB_DATA_XFER);
+			zassert_equal(sdo_u32(&d1, 0x1010, sub, 5), CO_SDO_AB_DATA_XFER);
+			zassert_ok(co_od_get_u32(&d1.od, 0x1010, sub, &v));
+			zassert_equal(v, 0, "a refused write changes nothing");
+		}
+	}
+	zassert_equal(co_storage_save(&d1.st, CO_OD_GROUP_ALL), -ENODEV);
+	zassert_equal(co_storage_clear(&d1.st, CO_OD_GROUP_ALL), -ENODEV);
+	zassert_ok(co_storage_restore(&d1.st, CO_OD_GROUP_ALL));
+	zassert_equal(co_storage_init_absent(NULL, &d1.od), -EINVAL);
+}
+
+/* Local control (the application) may forbid requests for a while: 08000021h, nothing
+ * stored; a wrong signature stays 08000020h; the application itself may still save. */
+ZTEST(storage, test_local_control_refuses_requests_with_08000021h)
+{
+	uint16_t hb;
+	uint32_t v;
+
+	boot(&d1, &ram_be.be, 5);
+	set_generation(&d1, 1);
+	co_storage_set_locked(&d1.st, true);
+	zassert_equal(sdo_u32(&d1, 0x1010, 1, CO_STORAGE_SIGNATURE_SAVE), CO_SDO_AB_DATA_LOC_CTRL);
+	zassert_equal(sdo_u32(&d1, 0x1011, 1, CO_STORAGE_SIGNATURE_LOAD), CO_SDO_AB_DATA_LOC_CTRL);
+	zassert_equal(sdo_u32(&d1, 0x1010, 1, 5), CO_SDO_AB_DATA_XFER);
+	zassert_ok(co_od_get_u32(&d1.od, 0x1010, 1, &v));
+	zassert_equal(v, 1, "the node still saves on command");
+	boot(&d2, &ram_be.be, 5);
+	zassert_ok(co_od_get_u16(&d2.od, 0x1017, 0, &hb));
+	zassert_equal(hb, 0, "nothing was stored");
+	zassert_ok(co_storage_save(&d1.st, CO_OD_GROUP_ALL), "the application's own save");
+	co_storage_set_locked(&d1.st, false);
+	set_generation(&d1, 2);
+	zassert_ok(sdo_u32(&d1, 0x1010, 1, CO_STORAGE_SIGNATURE_SAVE));
+	boot(&d2, &ram_be.be, 5);
+	zassert_ok(co_od_get_u16(&d2.od, 0x1017, 0, &hb));
+	zassert_equal(hb, 200);
+}
+
 ZTEST(storage, test_image_too_large)
 {
 	static uint8_t tiny[128];

@@ -151,7 +151,9 @@ def _network_dcf(path, node_id=None, slaves=(), mandatory=(), files=None, boot_t
     def key(n):
         return f"0x{n:X}" if n % 2 == 0 else str(n)
 
-    lines = []
+    # CiA 306's mandatory objects (the manager reads a DCF with scripts/eds2od's rules).
+    lines = ["[1000]", "ParameterValue=0", "", "[1001]", "ParameterValue=0", "", "[1018]",
+             "SubNumber=1", ""]
     if node_id is not None:
         lines += ["[DeviceComissioning]", f"NodeID=0x{node_id:02X}", ""]
     lines += ["[1F80]", "ParameterValue=0x00000001", "", "[1F89]", f"ParameterValue={boot_time}", ""]
@@ -166,6 +168,8 @@ def _network_dcf(path, node_id=None, slaves=(), mandatory=(), files=None, boot_t
     lines += ["[1016]", "SubNumber=9", ""]
     for i, n in enumerate(slaves[:8], 1):
         lines += [f"[1016sub{i}]", "DataType=0x0007", f"ParameterValue=0x00{n:02X}012C", ""]
+    if files:
+        lines += ["[1F22]", "ObjectType=0x8", "SubNumber=128", ""]
     for n, name in (files or {}).items():
         lines += [f"[1F22sub{n:X}]", "DataType=0x000F", f"UploadFile={name}", ""]
     path.write_text(extra + "\n".join(lines) + "\n")
@@ -252,8 +256,11 @@ def test_manager_refuses_a_dcf_it_cannot_serve(manager, tmp_path, case):
               "bad_number": "is not an unsigned 32-bit number",
               "nodeid_formula": "$NODEID", "text_cdcf": "scripts/dcf2cdcf",
               "bad_cdcf": "is not a concise DCF", "missing_cdcf": "cannot open",
-              "manager_is_slave": "node 1 is a slave", "too_many_slaves": "slave slots",
-              "sub_too_high": "is not a sub-index 1..127",
+              "manager_is_slave": "net.dcf:25: node 1 is a slave of the network (1F81h "
+                                  "assigns 1, 2)",
+              "too_many_slaves": "net.dcf:33: 1F81h assigns 10 slaves (2, 3, 4, 5, 6, 7, 8, 9, "
+                                 "10, 11); the manager has 8 slave slots",
+              "sub_too_high": "[1F84Value]: sub-index 0x80 is not 1..127 (CompactSubObj=127)",
               "value_too_big": "refused by the manager's dictionary"}[case]
     if case == "missing":
         path = tmp_path / "nonexistent.dcf"
@@ -284,6 +291,93 @@ def test_manager_refuses_a_dcf_it_cannot_serve(manager, tmp_path, case):
     result = _run(manager, *args)
     assert_refused(result, "dcf", args)
     assert expect in result.stderr, result.stderr
+
+
+def _edit(path, old, new, count=1):
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, count))
+
+
+# Each damage the manager once took (issue 29): the rule of scripts/eds2od it breaks, with the
+# message eds2od gives, FILE:LINE named.
+@pytest.mark.parametrize("case,expect", [
+    ("cut_in_a_value", "net.dcf:26: the file ends inside this line (no end of line)"),
+    ("fewer_entries", "net.dcf:24: NrOfEntries=4 but [1F81Value] has 2 entries"),
+    ("more_entries", "net.dcf:24: NrOfEntries=40 but [1F81Value] has 4 entries"),
+    ("bad_nr_of_entries", "net.dcf:24: NrOfEntries=four is not a number"),
+    ("duplicate_key", "net.dcf:15: duplicate key 'ParameterValue' in [1F89] (first at line 14)"),
+    ("duplicate_section", "duplicate section [1F89] (first at line 13)"),
+    ("duplicate_sub_section", "duplicate sub-index 1 of 1016h (first at line"),
+    ("sub_given_twice", "net.dcf:27: [1F81Value]: sub-index 3 given twice (first at line 26)"),
+    ("sub_not_hex", "[1016subZZ]: 'ZZ' is not a sub-index (one or two hex digits)"),
+    ("sub_too_long", "[1016sub1FF]: '1FF' is not a sub-index (one or two hex digits)"),
+    ("key_not_a_sub", "net.dcf:25: [1F81Value]: key 'two' is not a sub-index"),
+    ("misspelt_section", "[1F85Valeu] is no object section"),
+    ("value_without_object", "[1F84Value] has no object [1F84]"),
+    ("sub_without_object", "sub-index section [1F22sub2] has no object [1F22]"),
+    ("empty", "net.dcf:1: mandatory object 1000h (Device type) is missing; CiA 306 requires "
+              "1000h, 1001h and 1018h in every EDS/DCF"),
+    ("no_identity", "net.dcf:1: mandatory object 1018h (Identity object) is missing"),
+    ("dev_null", "/dev/null: cannot open: not a regular file"),
+    ("fifo", "net.dcf: cannot open: not a regular file"),
+    ("fifo_upload", "1F22h:02: cannot open"),
+])
+def test_manager_reads_its_dcf_with_the_rules_of_eds2od(manager, tmp_path, case, expect):
+    path = _network_dcf(tmp_path / "net.dcf", slaves=(2, 3, 4, 5), mandatory=(2, 3))
+    if case == "cut_in_a_value":
+        text = path.read_text()
+        path.write_text(text[:text.index("3=0x0000000D") + len("3=0x00")])
+    elif case == "fewer_entries":
+        _edit(path, "0x4=0x00000005\n5=0x00000005\n", "")
+    elif case == "more_entries":
+        _edit(path, "NrOfEntries=4", "NrOfEntries=40")
+    elif case == "bad_nr_of_entries":
+        _edit(path, "NrOfEntries=4", "NrOfEntries=four")
+    elif case == "duplicate_key":
+        _edit(path, "ParameterValue=2000\n", "ParameterValue=2000\nParameterValue=100\n")
+    elif case == "duplicate_section":
+        path.write_text(path.read_text() + "[1F89]\nParameterValue=100\n")
+    elif case == "duplicate_sub_section":
+        path.write_text(path.read_text() + "[1016sub01]\nParameterValue=0\n")
+    elif case == "sub_given_twice":
+        _edit(path, "0x4=0x00000005\n", "0x3=0x00000005\n")
+    elif case == "sub_not_hex":
+        _edit(path, "[1016sub1]", "[1016subZZ]")
+    elif case == "sub_too_long":
+        _edit(path, "[1016sub1]", "[1016sub1FF]")
+    elif case == "key_not_a_sub":
+        _edit(path, "0x2=0x0000000D", "two=0x0000000D")
+    elif case == "misspelt_section":
+        _edit(path, "[1F85Value]", "[1F85Valeu]")
+    elif case == "value_without_object":
+        path.write_text(path.read_text() + "[1F84Value]\nNrOfEntries=0\n")
+    elif case == "sub_without_object":
+        path.write_text(path.read_text() + "[1F22sub2]\nUploadFile=hello.bin\n")
+    elif case == "empty":
+        path.write_text("")
+    elif case == "no_identity":
+        _edit(path, "[1018]\nSubNumber=1\n", "")
+    elif case == "dev_null":
+        path = pathlib.Path("/dev/null")
+    elif case == "fifo":
+        path.unlink()
+        os.mkfifo(path)
+    elif case == "fifo_upload":
+        os.mkfifo(tmp_path / "hello.bin")
+        _network_dcf(path, slaves=(2,), files={2: "hello.bin"})
+    args = (f"--dcf={path}", "--stop-at=2")
+    result = _run(manager, *args)
+    assert_refused(result, "dcf", args)
+    assert expect in result.stderr, result.stderr
+
+
+@pytest.mark.parametrize("option", ["--dds-allow=none", "--dds-config=x.xml", "--dds-domain=7"])
+def test_manager_refuses_dds_options_without_dds(manager, option):
+    args = (option, "--stop-at=2")
+    result = _run(manager, *args)
+    assert_refused(result, option[2:option.index("=")], args)
+    assert "needs --dds (the DDS bridge)" in result.stderr
 
 
 def test_manager_refuses_a_node_id_of_the_dcf_network(manager, tmp_path):

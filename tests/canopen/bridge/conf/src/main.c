@@ -162,7 +162,7 @@ ZTEST(bridge_conf, test_allow_list_rules)
 {
 	zassert_equal(br_allow_load(&conf, CONF_TEST_DIR "/good_allow.conf"), 0);
 	zassert_true(conf.allow);
-	zassert_equal(conf.n_rules, 5);
+	zassert_equal(conf.n_rules, 8);
 
 	/* write ops 0 7 2001:00,2002 */
 	zassert_true(br_allow_write(&conf, "ops", 0, 7, 0x2001, 0));
@@ -183,19 +183,53 @@ ZTEST(bridge_conf, test_allow_list_rules)
 	zassert_false(br_allow_write(&conf, "range", 1, 6, 0x2000, 0));
 	zassert_false(br_allow_write(&conf, "range", 1, 4, 0x2100, 0));
 
-	/* nmt ops 0 1,all preop,start */
+	/* nmt ops 0 1 preop,start */
 	zassert_true(br_allow_nmt(&conf, "ops", 0, 1, BR_CMD_PREOP));
-	zassert_true(br_allow_nmt(&conf, "ops", 0, 0, BR_CMD_START), "all: the broadcast");
 	zassert_false(br_allow_nmt(&conf, "ops", 0, 1, BR_CMD_STOP));
 	zassert_false(br_allow_nmt(&conf, "ops", 0, 2, BR_CMD_START));
 	zassert_false(br_allow_nmt(&conf, "ops", 1, 1, BR_CMD_START));
-	/* nmt admin* * * *: the broadcast included */
+	/* nmt admin* * * *: each node, so the broadcast too */
 	zassert_true(br_allow_nmt(&conf, "admin", 3, 0, BR_CMD_RESET));
 	zassert_true(br_allow_nmt(&conf, "admin", 3, 127, BR_CMD_RESET_COMM));
 	zassert_false(br_allow_nmt(&conf, "guest", 0, 1, BR_CMD_START));
 	/* Writes and NMT are separate rules. */
 	zassert_false(br_allow_nmt(&conf, "range", 1, 3, BR_CMD_START));
 	zassert_false(br_allow_write(&conf, "ops", 0, 1, 0x2001, 0));
+}
+
+/* "all" is every node: the broadcast (and a request object's sub-index 80h) is allowed only
+ * where each node 1..127 is, whichever rules allow them. */
+ZTEST(bridge_conf, test_a_request_for_all_nodes_needs_each_node_allowed)
+{
+	zassert_equal(br_allow_load(&conf, CONF_TEST_DIR "/good_allow.conf"), 0);
+
+	/* nmt ops 0 1 ...: node 1 alone is not everybody. */
+	zassert_true(br_allow_nmt(&conf, "ops", 0, 1, BR_CMD_START));
+	zassert_false(br_allow_nmt(&conf, "ops", 0, 0, BR_CMD_START));
+	/* nmt split 0 1-63 start,stop + nmt split 0 64-127 start: two rules cover 1..127 for
+	 * start, not for stop. */
+	zassert_true(br_allow_nmt(&conf, "split", 0, 0, BR_CMD_START));
+	zassert_true(br_allow_nmt(&conf, "split", 0, 5, BR_CMD_STOP));
+	zassert_false(br_allow_nmt(&conf, "split", 0, 0, BR_CMD_STOP), "64..127 may not stop");
+	zassert_false(br_allow_nmt(&conf, "split", 1, 0, BR_CMD_START), "another line");
+	for (uint8_t bit = BR_CMD_START; bit <= BR_CMD_RESET_COMM && bit != 0U; bit <<= 1) {
+		zassert_true(br_allow_nmt(&conf, "admin", 0, 0, bit), "admin: every command");
+		zassert_false(br_allow_nmt(&conf, "ops", 0, 0, bit));
+	}
+
+	/* write admin* * * *: every sub-index, 80h (all nodes) with them. */
+	zassert_true(br_allow_write(&conf, "admin", 0, 1, 0x1F82, 0x80));
+	/* write mgr5 0 1 1F82:05,1F82:80,...: 80h named, but not each node. */
+	zassert_true(br_allow_write(&conf, "mgr5", 0, 1, 0x1F82, 0x05));
+	zassert_false(br_allow_write(&conf, "mgr5", 0, 1, 0x1F82, 0x80), "request NMT, all");
+	zassert_false(br_allow_write(&conf, "mgr5", 0, 1, 0x1F83, 0x80), "request guarding");
+	zassert_false(br_allow_write(&conf, "mgr5", 0, 1, 0x1F25, 0x80), "configuration request");
+	zassert_true(br_allow_write(&conf, "admin", 0, 1, 0x1F83, 0x80));
+	/* Sub-index 80h of another object is only itself. */
+	zassert_true(br_allow_write(&conf, "range", 1, 3, 0x2000, 0x80));
+	zassert_true(br_allow_is_for_all_nodes(0x1F82, 0x80));
+	zassert_false(br_allow_is_for_all_nodes(0x1F82, 0x7F));
+	zassert_false(br_allow_is_for_all_nodes(0x1F81, 0x80));
 }
 
 ZTEST(bridge_conf, test_no_allow_list_is_read_only)
