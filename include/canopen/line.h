@@ -5,7 +5,7 @@
 
 /**
  * @file
- * @brief CANopen line: one CAN interface, one thread, one receive table, one deadline list.
+ * @brief CANopen line: one CAN interface, one thread, one receive table, one timer heap.
  *
  * A line is the unit of concurrency of the stack (doc/architecture.md). Services register receivers
  * (by COB-ID) and timers (by absolute deadline) on the line. The line dispatches each received
@@ -178,6 +178,10 @@ struct co_rx {
 typedef uint64_t co_time4_t __attribute__((aligned(4)));
 /** @endcond */
 
+/** @cond INTERNAL_HIDDEN */
+#define CO_TIMER_UNARMED 0xffffU
+/** @endcond */
+
 /** A deadline bound to a handler. Embedded in a service. */
 struct co_timer {
 	/** Handler; called with @ref lock held. */
@@ -188,10 +192,12 @@ struct co_timer {
 	void *user_data;
 
 	/** @cond INTERNAL_HIDDEN */
-	sys_snode_t node;
-	/* Armed: in the line's list (node.next is NULL only for the last one, and outside). */
 	co_time4_t deadline;
 	struct co_line *line;
+	/* Arming number on its line: equal deadlines run in arming order. */
+	uint32_t seq;
+	/* Place in the line's heap of armed timers, CO_TIMER_UNARMED when not armed. */
+	uint16_t slot;
 	/** @endcond */
 };
 
@@ -220,6 +226,8 @@ struct co_line_stats {
 	uint32_t tx_purged;
 	/** Receivers a frame did not reach: more matched than CONFIG_CANOPEN_LINE_RX_FANOUT. */
 	uint32_t rx_fanout_drops;
+	/** Timers not armed: CONFIG_CANOPEN_LINE_TIMERS were armed already (logged once). */
+	uint32_t timer_overflows;
 };
 
 /** @cond INTERNAL_HIDDEN */
@@ -278,14 +286,20 @@ struct co_line {
 	 * was even and unchanged around the read (line.c, "Receive table").
 	 */
 	uint32_t rx_seq;
-	/* Armed timers sorted by deadline. */
-	sys_slist_t timers;
 	/*
-	 * The timer co_line_process() took off the list and is about to run; a start or stop
+	 * Armed timers, a binary min-heap by (deadline, seq): timers[0] runs first, a timer's
+	 * children are at 2 * slot + 1 and 2 * slot + 2 (line.c, "Timers").
+	 */
+	struct co_timer *timers[CONFIG_CANOPEN_LINE_TIMERS];
+	uint16_t n_timers;
+	/* Arming number of the next co_timer_start(). */
+	uint32_t timer_seq;
+	/*
+	 * The timer co_line_process() took off the heap and is about to run; a start or stop
 	 * of it meanwhile (by its owner, in another thread) clears this, and it does not run.
 	 */
 	struct co_timer *popped;
-	/* Serialises changes of the receive table, protects the timer list. Leaf lock: never
+	/* Serialises changes of the receive table, protects the timer heap. Leaf lock: never
 	 * held while a node lock is taken.
 	 */
 	struct k_mutex lock;
@@ -502,6 +516,11 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
  * @brief Arm a timer for an absolute deadline, replacing any earlier deadline.
  *
  * May be called from any thread; the line thread wakes if the new deadline comes first.
+ * Costs O(log n) in the armed timers of the line. When CONFIG_CANOPEN_LINE_TIMERS timers are
+ * armed on the line already, the timer stays disarmed: the line counts it
+ * (co_line_stats.timer_overflows) and logs an error the first time. The services call it
+ * through co_node_timer_start(), which returns nothing, from handlers that cannot undo what
+ * they did: a size that fits the services a node runs is the remedy, not a return value.
  *
  * @param line Line whose thread runs the handler.
  * @param timer Initialised timer.

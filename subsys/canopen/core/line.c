@@ -7,10 +7,10 @@
  * The I/O-free core of a line: receive table, timers, TX queue. The threaded binding is in
  * line_thread.c; everything here also runs on simulated time from a unit test.
  *
- * Locking: line->lock serialises changes of the receive table, protects the timer list and
+ * Locking: line->lock serialises changes of the receive table, protects the timer heap and
  * is a leaf lock. Receivers are looked up without it (a sequence count, see "Receive table"),
  * so a received frame takes one lock: its receiver's (the node's mutex). A timer handler is
- * taken off the list under line->lock, which is released before the owner's lock is taken,
+ * taken off the heap under line->lock, which is released before the owner's lock is taken,
  * so a node lock is never acquired while line->lock is held (no lock-order inversion with an
  * application thread that holds its node lock and arms a timer).
  */
@@ -79,7 +79,6 @@ static void line_init_common(struct co_line *line, const char *name)
 	for (int i = 0; i <= CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
 		line->rx_key[i] = (uint16_t)CO_LINE_KEY_FREE;
 	}
-	sys_slist_init(&line->timers);
 	k_msgq_init(&line->rxq, line->rxq_buf, sizeof(struct co_line_rx_msg),
 		    CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE);
 	k_mutex_init(&line->lock);
@@ -706,22 +705,102 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
 	timer->handler = handler;
 	timer->lock = lock;
 	timer->user_data = user_data;
+	timer->slot = CO_TIMER_UNARMED;
 }
 
 /*
- * Whether a timer is in its line's list: every removal (sys_slist_remove()) and the insert at
- * the tail clear node.next, so outside the list it is NULL, as for the last timer in it.
+ * Armed timers: a binary min-heap per line (line->timers[0..n_timers-1]), each timer knowing
+ * its place (slot), so a start or stop costs O(log n) and the next deadline is timers[0].
+ * Equal deadlines keep arming order through the timer's arming number (seq).
  */
+
+/* Whether @p a runs before @p b: earlier deadline, or the same one and armed earlier. */
+static bool timer_before(const struct co_timer *a, const struct co_timer *b)
+{
+	if (a->deadline != b->deadline) {
+		return co_time_before_eq(a->deadline, b->deadline);
+	}
+	return (int32_t)(a->seq - b->seq) < 0;
+}
+
+static void heap_put(struct co_line *line, struct co_timer *t, unsigned int i)
+{
+	line->timers[i] = t;
+	t->slot = (uint16_t)i;
+}
+
+/* Move the timer at @p i towards the root while it runs before its parent. */
+static void heap_up(struct co_line *line, unsigned int i)
+{
+	struct co_timer *t = line->timers[i];
+
+	while (i > 0U) {
+		unsigned int parent = (i - 1U) / 2U;
+
+		if (!timer_before(t, line->timers[parent])) {
+			break;
+		}
+		heap_put(line, line->timers[parent], i);
+		i = parent;
+	}
+	heap_put(line, t, i);
+}
+
+/* Move the timer at @p i towards the leaves while a child runs before it. */
+static void heap_down(struct co_line *line, unsigned int i)
+{
+	struct co_timer *t = line->timers[i];
+	unsigned int n = line->n_timers;
+
+	for (;;) {
+		unsigned int c = 2U * i + 1U;
+
+		if (c >= n) {
+			break;
+		}
+		if (c + 1U < n && timer_before(line->timers[c + 1U], line->timers[c])) {
+			c++;
+		}
+		if (!timer_before(line->timers[c], t)) {
+			break;
+		}
+		heap_put(line, line->timers[c], i);
+		i = c;
+	}
+	heap_put(line, t, i);
+}
+
+/* Take an armed timer out of the heap: the last one fills its place and moves up or down. */
+static void heap_remove(struct co_line *line, struct co_timer *t)
+{
+	unsigned int i = t->slot;
+	unsigned int last = line->n_timers - 1U;
+
+	t->slot = CO_TIMER_UNARMED;
+	line->n_timers = (uint16_t)last;
+	if (i != last) {
+		struct co_timer *moved = line->timers[last];
+
+		heap_put(line, moved, i);
+		if (i > 0U && timer_before(moved, line->timers[(i - 1U) / 2U])) {
+			heap_up(line, i);
+		} else {
+			heap_down(line, i);
+		}
+	}
+	line->timers[last] = NULL;
+}
+
+/* Whether a timer is in its line's heap (line lock held). */
 static bool timer_armed(const struct co_line *line, const struct co_timer *timer)
 {
-	return sys_slist_peek_next_no_check(&timer->node) != NULL ||
-	       sys_slist_peek_tail(&line->timers) == &timer->node;
+	return timer->line == line && timer->slot != CO_TIMER_UNARMED;
 }
 
 static void timer_unlink(struct co_line *line, struct co_timer *timer)
 {
 	if (timer_armed(line, timer)) {
-		(void)sys_slist_find_and_remove(&line->timers, &timer->node);
+		heap_remove(line, timer);
 	}
 	/* Any start or stop makes the timer stale if co_line_process() has just taken it. */
 	if (line->popped == timer) {
@@ -729,12 +808,19 @@ static void timer_unlink(struct co_line *line, struct co_timer *timer)
 	}
 }
 
+/* The heap is full: the timer stays disarmed, counted and logged (the first time). */
+static __attribute__((noinline)) void timer_overflow(struct co_line *line)
+{
+	if (line->stats.timer_overflows++ == 0U) {
+		LOG_ERR("%s: more than %d timers armed; raise CONFIG_CANOPEN_LINE_TIMERS",
+			line->name, CONFIG_CANOPEN_LINE_TIMERS);
+	}
+}
+
 void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us)
 {
 	struct co_line *old = timer->line;
-	sys_snode_t *prev = NULL;
-	sys_snode_t *cur;
-	bool first;
+	bool first = false;
 
 	if (old != NULL && old != line) {
 		co_timer_stop(timer);
@@ -743,17 +829,17 @@ void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadl
 	timer_unlink(line, timer);
 	timer->deadline = deadline_us;
 	timer->line = line;
-	/* Sorted insert; equal deadlines keep arming order. */
-	SYS_SLIST_FOR_EACH_NODE(&line->timers, cur) {
-		struct co_timer *t = CONTAINER_OF(cur, struct co_timer, node);
-
-		if (!co_time_before_eq(t->deadline, deadline_us)) {
-			break;
-		}
-		prev = cur;
+	if (line->n_timers < CONFIG_CANOPEN_LINE_TIMERS) {
+		timer->seq = line->timer_seq++;
+		heap_put(line, timer, line->n_timers);
+		line->n_timers++;
+		heap_up(line, timer->slot);
+		first = (timer->slot == 0U);
+	} else {
+		/* Not armed, whatever a zeroed timer's slot said. */
+		timer->slot = CO_TIMER_UNARMED;
+		timer_overflow(line);
 	}
-	sys_slist_insert(&line->timers, prev, &timer->node);
-	first = (prev == NULL);
 	k_mutex_unlock(&line->lock);
 
 	if (first) {
@@ -790,34 +876,25 @@ bool co_timer_is_armed(const struct co_timer *timer)
 uint64_t co_line_next_deadline(struct co_line *line)
 {
 	uint64_t next = UINT64_MAX;
-	sys_snode_t *head;
 
 	k_mutex_lock(&line->lock, K_FOREVER);
-	head = sys_slist_peek_head(&line->timers);
-	if (head != NULL) {
-		next = CONTAINER_OF(head, struct co_timer, node)->deadline;
+	if (line->n_timers > 0U) {
+		next = line->timers[0]->deadline;
 	}
 	k_mutex_unlock(&line->lock);
 	return next;
 }
 
-/* Take the first expired timer off the list, or return NULL. */
+/* Take the first expired timer out of the heap, or return NULL. */
 static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us)
 {
 	struct co_timer *t = NULL;
-	sys_snode_t *head;
 
 	k_mutex_lock(&line->lock, K_FOREVER);
-	head = sys_slist_peek_head(&line->timers);
-	if (head != NULL) {
-		struct co_timer *first = CONTAINER_OF(head, struct co_timer, node);
-
-		if (co_time_before_eq(first->deadline, now_us)) {
-			/* Not sys_slist_get(): Zephyr's leaves node.next as it was. */
-			sys_slist_remove(&line->timers, NULL, head);
-			line->popped = first;
-			t = first;
-		}
+	if (line->n_timers > 0U && co_time_before_eq(line->timers[0]->deadline, now_us)) {
+		t = line->timers[0];
+		heap_remove(line, t);
+		line->popped = t;
 	}
 	k_mutex_unlock(&line->lock);
 	return t;
@@ -1069,12 +1146,15 @@ static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 			rx_unlink_at(line, i);
 		}
 	}
-	struct co_timer *t;
-	struct co_timer *tn;
+	/* From the start again after each removal: the heap moves timers around. */
+	for (unsigned int i = 0U; i < line->n_timers;) {
+		struct co_timer *t = line->timers[i];
 
-	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&line->timers, t, tn, node) {
 		if (t->lock == lock) {
 			timer_unlink(line, t);
+			i = 0U;
+		} else {
+			i++;
 		}
 	}
 }
@@ -1221,4 +1301,7 @@ void co_line_get_stats(struct co_line *line, struct co_line_stats *stats)
 	stats->rx_unhandled = __atomic_load_n(&line->stats.rx_unhandled, __ATOMIC_RELAXED);
 	stats->rx_fanout_drops = __atomic_load_n(&line->stats.rx_fanout_drops, __ATOMIC_RELAXED);
 	stats->rx_overruns = __atomic_load_n(&line->stats.rx_overruns, __ATOMIC_RELAXED);
+	k_mutex_lock(&line->lock, K_FOREVER);
+	stats->timer_overflows = line->stats.timer_overflows;
+	k_mutex_unlock(&line->lock);
 }

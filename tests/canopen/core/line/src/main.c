@@ -621,6 +621,115 @@ ZTEST(co_line, test_a_timer_is_armed_wherever_it_is_in_the_list)
 	zassert_equal(b.fired, 1, "the next one still runs");
 }
 
+/* Deadlines of the heap tests: not in order, with repeats (equal ones keep arming order). */
+#define HEAP_N 15
+static const uint16_t heap_deadline[HEAP_N] = {700, 300,  900, 300, 100, 800, 500, 300,
+					       200, 1000, 600, 100, 400, 900, 300};
+
+static struct tagged_timer heap_timers[HEAP_N];
+
+static void heap_arm_all(void)
+{
+	for (int i = 0; i < HEAP_N; i++) {
+		heap_timers[i] = (struct tagged_timer){.tag = i};
+		co_timer_init(&heap_timers[i].t, timer_handler, &fx.node_lock, NULL);
+		co_timer_start(&fx.line, &heap_timers[i].t, heap_deadline[i]);
+	}
+}
+
+/* Whether the log holds the timers in deadline order, equal deadlines in tag order. */
+static void assert_log_in_order(int n)
+{
+	for (int i = 1; i < n; i++) {
+		uint16_t a = heap_deadline[fx.log[i - 1]];
+		uint16_t b = heap_deadline[fx.log[i]];
+
+		zassert_true(a < b || (a == b && fx.log[i - 1] < fx.log[i]), "position %d: %d, %d",
+			     i, fx.log[i - 1], fx.log[i]);
+	}
+}
+
+/* Fifteen timers armed out of order run by deadline, equal deadlines in arming order. */
+ZTEST(co_line, test_timer_heap_runs_by_deadline_then_arming_order)
+{
+	heap_arm_all();
+	zassert_equal(co_line_next_deadline(&fx.line), 100);
+	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
+	zassert_equal(fx.log_len, HEAP_N);
+	assert_log_in_order(HEAP_N);
+	zassert_equal(fx.log[0], 4, "first of the two at 100");
+	zassert_equal(fx.log[1], 11);
+}
+
+/*
+ * Timers stopped from the middle of the heap and from its end, and timers restarted earlier
+ * and later, leave the others in order: each runs once at its new deadline or not at all.
+ */
+ZTEST(co_line, test_timer_heap_stop_and_restart_in_the_middle)
+{
+	/* Stopped: 6 (500), 2 (900) and 14 (the last armed); restarted: 9 to 50, 4 to 950. */
+	heap_arm_all();
+	co_timer_stop(&heap_timers[6].t);
+	co_timer_stop(&heap_timers[2].t);
+	co_timer_stop(&heap_timers[14].t);
+	co_timer_start(&fx.line, &heap_timers[9].t, 50);
+	co_timer_start(&fx.line, &heap_timers[4].t, 950);
+	zassert_equal(co_line_next_deadline(&fx.line), 50);
+	zassert_false(co_timer_is_armed(&heap_timers[6].t));
+	zassert_equal(co_line_process(&fx.line, 60), 100);
+	zassert_equal(fx.log_len, 1);
+	zassert_equal(fx.log[0], 9, "restarted earlier");
+	zassert_equal(co_line_process(&fx.line, 900), 950);
+	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
+	zassert_equal(fx.log_len, HEAP_N - 3);
+	zassert_equal(fx.log[HEAP_N - 4], 4, "restarted later: last");
+	for (int i = 0; i < fx.log_len; i++) {
+		zassert_true(fx.log[i] != 6 && fx.log[i] != 2 && fx.log[i] != 14, "stopped %d ran",
+			     fx.log[i]);
+	}
+	/* Between the first (9) and the last (4), the rest in order. */
+	for (int i = 2; i < HEAP_N - 4; i++) {
+		uint16_t a = heap_deadline[fx.log[i - 1]];
+		uint16_t b = heap_deadline[fx.log[i]];
+
+		zassert_true(a < b || (a == b && fx.log[i - 1] < fx.log[i]), "position %d", i);
+	}
+}
+
+/*
+ * A line arms CONFIG_CANOPEN_LINE_TIMERS timers at once; one more stays disarmed, counted and
+ * logged, and the others are unharmed. Once one has run there is room again.
+ */
+ZTEST(co_line, test_timer_heap_full_leaves_the_timer_disarmed_and_counts_it)
+{
+	static struct tagged_timer t[CONFIG_CANOPEN_LINE_TIMERS + 1];
+	struct co_line_stats st;
+
+	for (int i = 0; i <= CONFIG_CANOPEN_LINE_TIMERS; i++) {
+		t[i] = (struct tagged_timer){.tag = i};
+		co_timer_init(&t[i].t, timer_handler, &fx.node_lock, NULL);
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_TIMERS; i++) {
+		co_timer_start(&fx.line, &t[i].t, 1000U + (uint64_t)i);
+	}
+	co_timer_start(&fx.line, &t[CONFIG_CANOPEN_LINE_TIMERS].t, 10);
+	zassert_false(co_timer_is_armed(&t[CONFIG_CANOPEN_LINE_TIMERS].t));
+	co_timer_stop(&t[CONFIG_CANOPEN_LINE_TIMERS].t); /* harmless */
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.timer_overflows, 1);
+	zassert_equal(co_line_next_deadline(&fx.line), 1000, "the others are unharmed");
+	zassert_true(co_timer_is_armed(&t[0].t));
+
+	zassert_equal(co_line_process(&fx.line, 1000), 1001);
+	co_timer_start(&fx.line, &t[CONFIG_CANOPEN_LINE_TIMERS].t, 1000);
+	zassert_true(co_timer_is_armed(&t[CONFIG_CANOPEN_LINE_TIMERS].t), "room again");
+	zassert_equal(co_line_process(&fx.line, 5000), UINT64_MAX);
+	zassert_equal(fx.log_len, CONFIG_CANOPEN_LINE_TIMERS + 1);
+	zassert_equal(fx.log[1], CONFIG_CANOPEN_LINE_TIMERS, "at 1000: before 1001");
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.timer_overflows, 1);
+}
+
 static K_THREAD_STACK_DEFINE(processor_stack, 4096);
 static struct k_thread processor;
 
