@@ -5,7 +5,7 @@
 
 /**
  * @file
- * @brief CANopen line: one CAN interface, one thread, one receive table, one deadline list.
+ * @brief CANopen line: one CAN interface, one thread, one receive table, one timer heap.
  *
  * A line is the unit of concurrency of the stack (doc/architecture.md). Services register receivers
  * (by COB-ID) and timers (by absolute deadline) on the line. The line dispatches each received
@@ -43,8 +43,13 @@ struct co_line;
 struct co_rx;
 struct co_timer;
 
-/** Number of 11-bit CAN identifiers, the size of the direct receive index. */
-#define CO_LINE_SFF_IDS 2048U
+/** @cond INTERNAL_HIDDEN */
+/* Keys of the receive table beyond the 11-bit ids (struct co_line, rx_key). */
+#define CO_LINE_KEY_MASKED 0x8000U
+#define CO_LINE_KEY_FREE   0xffffU
+/* In co_line.rx_masked_codes: a 29-bit receiver is registered. */
+#define CO_LINE_MASKED_EXT (1U << 16)
+/** @endcond */
 
 /**
  * @brief Receive a frame.
@@ -151,13 +156,13 @@ struct co_rx {
 	void *user_data;
 
 	/** @cond INTERNAL_HIDDEN */
-#if !defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	/* The next receiver of the same 11-bit id, or of the masked and 29-bit ones. */
-	struct co_rx *next;
-#endif
 	struct co_line *line;
-	/* The line's copy of (id, ext) and mask, for masked and 29-bit receivers: written when
-	 * the receiver joins a line, read by lookups that take no lock (line.c).
+	/*
+	 * The line's copy of the frame key (id, with bit 31 for a 29-bit id) and of the mask, for
+	 * masked and 29-bit receivers: written under the table lock when the receiver joins a
+	 * line and read by lookups that take no lock (line.c), while the owner may rewrite id,
+	 * mask and ext of a receiver it has just unregistered. Exact 11-bit receivers are
+	 * matched by the table's key array and never read them.
 	 */
 	uint32_t key_id;
 	uint32_t key_mask;
@@ -173,6 +178,10 @@ struct co_rx {
 typedef uint64_t co_time4_t __attribute__((aligned(4)));
 /** @endcond */
 
+/** @cond INTERNAL_HIDDEN */
+#define CO_TIMER_UNARMED 0xffffU
+/** @endcond */
+
 /** A deadline bound to a handler. Embedded in a service. */
 struct co_timer {
 	/** Handler; called with @ref lock held. */
@@ -183,10 +192,12 @@ struct co_timer {
 	void *user_data;
 
 	/** @cond INTERNAL_HIDDEN */
-	sys_snode_t node;
-	/* Armed: in the line's list (node.next is NULL only for the last one, and outside). */
 	co_time4_t deadline;
 	struct co_line *line;
+	/* Arming number on its line: equal deadlines run in arming order. */
+	uint32_t seq;
+	/* Place in the line's heap of armed timers, CO_TIMER_UNARMED when not armed. */
+	uint16_t slot;
 	/** @endcond */
 };
 
@@ -215,6 +226,8 @@ struct co_line_stats {
 	uint32_t tx_purged;
 	/** Receivers a frame did not reach: more matched than CONFIG_CANOPEN_LINE_RX_FANOUT. */
 	uint32_t rx_fanout_drops;
+	/** Timers not armed: CONFIG_CANOPEN_LINE_TIMERS were armed already (logged once). */
+	uint32_t timer_overflows;
 };
 
 /** @cond INTERNAL_HIDDEN */
@@ -248,46 +261,45 @@ struct co_line_rx_msg {
 
 struct co_line {
 	const char *name;
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	/* Receive table: the n_rx receivers, the n_exact exact 11-bit ones first, each part in
-	 * registration order (the order in which a frame reaches them).
+	/*
+	 * Receive table (line.c, "Receive table"): rx_key[i] is the key of receiver rx_tab[i].
+	 * The rx_exact exact 11-bit receivers come first, sorted by id (key: the id; receivers of
+	 * one id in registration order), then the masked and 29-bit ones (CO_LINE_KEY_MASKED, in
+	 * registration order), then free entries (CO_LINE_KEY_FREE, NULL). rx_used entries in all.
+	 * One more key, always free, ends every run of equal keys inside the array.
 	 */
 	struct co_rx *rx_tab[CONFIG_CANOPEN_LINE_RX_SLOTS];
-	uint8_t n_rx;
-	uint8_t n_exact;
-#elif defined(CONFIG_CANOPEN_LINE_RX_INDEX)
-	/* Receive table: sff[id] is 1 + slot of the first receiver of 11-bit id, 0 for none. */
-	uint8_t sff[CO_LINE_SFF_IDS];
-#else
-	/* Receive table: the ids of the n_slots used slots, ascending (slots[i] is ids[i]'s). */
-	uint16_t slot_ids[CONFIG_CANOPEN_LINE_RX_SLOTS];
-	uint8_t n_slots;
-#endif
-	/*
-	 * Nodes attached; from two on, frames a node sends reach the others (local delivery).
-	 * Here, beside the table's counts, rather than in a padded word of its own.
-	 */
+	uint16_t rx_key[CONFIG_CANOPEN_LINE_RX_SLOTS + 1];
+	uint8_t rx_exact;
+	uint8_t rx_used;
+	/* Nodes attached; from two on, frames a node sends reach the others (local delivery). */
 	uint8_t n_nodes;
-#if !defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	/* Heads of the chains of receivers of one 11-bit id. */
-	struct co_rx *slots[CONFIG_CANOPEN_LINE_RX_SLOTS];
-	/* 29-bit and masked receivers, searched in order. */
-	struct co_rx *others;
-#endif
+	/*
+	 * Which frames the masked part can match: bit g (0..15) when a masked 11-bit receiver
+	 * matches some id of function code g (id >> 7), CO_LINE_MASKED_EXT when a 29-bit
+	 * receiver is registered. A frame walks the masked part only when its bit is set.
+	 */
+	uint32_t rx_masked_codes;
 	/*
 	 * Sequence count of the receive table: odd while a writer (holding lock) changes it.
 	 * Lookups read the table without the lock and keep their result only when the count
 	 * was even and unchanged around the read (line.c, "Receive table").
 	 */
 	uint32_t rx_seq;
-	/* Armed timers sorted by deadline. */
-	sys_slist_t timers;
 	/*
-	 * The timer co_line_process() took off the list and is about to run; a start or stop
+	 * Armed timers, a binary min-heap by (deadline, seq): timers[0] runs first, a timer's
+	 * children are at 2 * slot + 1 and 2 * slot + 2 (line.c, "Timers").
+	 */
+	struct co_timer *timers[CONFIG_CANOPEN_LINE_TIMERS];
+	uint16_t n_timers;
+	/* Arming number of the next co_timer_start(). */
+	uint32_t timer_seq;
+	/*
+	 * The timer co_line_process() took off the heap and is about to run; a start or stop
 	 * of it meanwhile (by its owner, in another thread) clears this, and it does not run.
 	 */
 	struct co_timer *popped;
-	/* Serialises changes of the receive table, protects the timer list. Leaf lock: never
+	/* Serialises changes of the receive table, protects the timer heap. Leaf lock: never
 	 * held while a node lock is taken.
 	 */
 	struct k_mutex lock;
@@ -467,15 +479,15 @@ static inline void co_rx_init(struct co_rx *rx, uint32_t id, co_rx_handler_t han
  *
  * Fill @p rx (id, mask, ext, handler, lock, user_data) first. Several receivers may share one
  * COB-ID; each gets every matching frame, exact 11-bit receivers (mask 7FFh) first, each kind
- * in registration order. An exact 11-bit receiver is found by its id; masked and 29-bit
- * receivers are searched in a short list. With CONFIG_CANOPEN_LINE_RX_FLAT a frame is compared
- * with every receiver of the line.
+ * in registration order. Each receiver, of any kind, takes one of the line's
+ * CONFIG_CANOPEN_LINE_RX_SLOTS entries. A frame's exact receivers are found by a binary search
+ * over the whole table (the same number of steps however many are registered); masked and
+ * 29-bit receivers are compared only with frames they can match (by function code).
  *
  * @retval 0 Registered.
  * @retval -EALREADY @p rx is already registered on a line.
  * @retval -EINVAL The id does not fit 11 (or 29) bits.
- * @retval -ENOSPC All CONFIG_CANOPEN_LINE_RX_SLOTS distinct 11-bit ids are in use (with
- *         CONFIG_CANOPEN_LINE_RX_FLAT: that many receivers are registered).
+ * @retval -ENOSPC All CONFIG_CANOPEN_LINE_RX_SLOTS entries are in use.
  */
 int co_rx_register(struct co_line *line, struct co_rx *rx);
 
@@ -489,7 +501,8 @@ void co_rx_unregister(struct co_rx *rx);
  *
  * @retval 0 Moved (or registered, if it was not).
  * @retval -EINVAL The id does not fit.
- * @retval -ENOSPC No slot for the new id; the receiver is then unregistered.
+ * @retval -ENOSPC No free entry (for a receiver that was not registered on @p line); it is
+ *         then unregistered.
  */
 int co_rx_set_id(struct co_line *line, struct co_rx *rx, uint32_t id);
 
@@ -503,6 +516,11 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
  * @brief Arm a timer for an absolute deadline, replacing any earlier deadline.
  *
  * May be called from any thread; the line thread wakes if the new deadline comes first.
+ * Costs O(log n) in the armed timers of the line. When CONFIG_CANOPEN_LINE_TIMERS timers are
+ * armed on the line already, the timer stays disarmed: the line counts it
+ * (co_line_stats.timer_overflows) and logs an error the first time. The services call it
+ * through co_node_timer_start(), which returns nothing, from handlers that cannot undo what
+ * they did: a size that fits the services a node runs is the remedy, not a return value.
  *
  * @param line Line whose thread runs the handler.
  * @param timer Initialised timer.

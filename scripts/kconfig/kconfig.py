@@ -100,10 +100,16 @@ def main():
         checked = []
     else:
         replace = True
+        board = set()
         for frag in args.fragments:
             kconf.load_config(frag, replace=replace)
+            if replace:
+                # The board's defconfig (first) may set options of subsystems an
+                # application leaves out (CONFIG_CANOPEN_LOCK_CHECK without CANopen).
+                board = set(user_assignments(kconf))
             replace = False
-        checked = user_assignments(kconf)
+        checked = [s for s in user_assignments(kconf)
+                   if s not in board or s.direct_dep.tri_value != 0]
 
     errors = [w for w in kconf.warnings]
     for sym in checked:

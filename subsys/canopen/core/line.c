@@ -7,16 +7,15 @@
  * The I/O-free core of a line: receive table, timers, TX queue. The threaded binding is in
  * line_thread.c; everything here also runs on simulated time from a unit test.
  *
- * Locking: line->lock serialises changes of the receive table, protects the timer list and
+ * Locking: line->lock serialises changes of the receive table, protects the timer heap and
  * is a leaf lock. Receivers are looked up without it (a sequence count, see "Receive table"),
  * so a received frame takes one lock: its receiver's (the node's mutex). A timer handler is
- * taken off the list under line->lock, which is released before the owner's lock is taken,
+ * taken off the heap under line->lock, which is released before the owner's lock is taken,
  * so a node lock is never acquired while line->lock is held (no lock-order inversion with an
  * application thread that holds its node lock and arms a timer).
  */
 
 #include <errno.h>
-#include <limits.h>
 #include <string.h>
 
 #include <zephyr/kernel.h>
@@ -36,7 +35,7 @@ LOG_MODULE_REGISTER(co_line, CONFIG_CANOPEN_LOG_LEVEL);
 #endif
 
 /* The 11-bit identifiers, 0 to 7FFh. */
-#define SFF_MASK (CO_LINE_SFF_IDS - 1U)
+#define SFF_MASK 0x7ffU
 #define EFF_MASK 0x1fffffffU
 
 uint64_t co_line_now(void)
@@ -76,7 +75,10 @@ static void line_init_common(struct co_line *line, const char *name)
 {
 	memset(line, 0, sizeof(*line));
 	line->name = name;
-	sys_slist_init(&line->timers);
+	/* Every entry free: keys sort after every receiver's. */
+	for (int i = 0; i <= CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
+		line->rx_key[i] = (uint16_t)CO_LINE_KEY_FREE;
+	}
 	k_msgq_init(&line->rxq, line->rxq_buf, sizeof(struct co_line_rx_msg),
 		    CONFIG_CANOPEN_LINE_RX_QUEUE_SIZE);
 	k_mutex_init(&line->lock);
@@ -245,23 +247,35 @@ void co_line_listener_remove(struct co_line_listener *l)
 /* --- Receive table --------------------------------------------------------------------- */
 
 /*
+ * One table per line (struct co_line): rx_tab[] holds the receivers and rx_key[] their keys,
+ * ascending over the whole capacity. The exact 11-bit receivers come first with their id as
+ * key, those of one id adjacent in registration order; then the masked and 29-bit ones
+ * (CO_LINE_KEY_MASKED) in registration order; then the free entries (CO_LINE_KEY_FREE). A
+ * frame's exact receivers are the run of its id, found by a lower-bound search over the whole
+ * capacity: always ceil(log2(CONFIG_CANOPEN_LINE_RX_SLOTS)) steps, so the receivers of other
+ * ids cost a frame nothing. The masked part is walked only by frames that one of its
+ * receivers can match: rx_masked_codes has bit g when a masked 11-bit receiver matches some
+ * id of function code g, so a heartbeat-range receiver costs an RPDO one test.
+ *
  * Lookups take no lock. Changes (register, unregister, move, detach) are made under
  * line->lock, between two increments of line->rx_seq: odd while a change is under way. A
  * lookup reads rx_seq, walks the table and reads rx_seq again; it keeps what it found only
  * when both reads gave the same even count, else (or while a writer is at work) it looks
- * again under the lock. Every word a lookup reads (the index, the slots or the flat table,
- * the chains, the match keys, rx_seq) is written with a release store and read with an
- * acquire load: a lookup that sees any part of a change also sees the odd count the
- * change began with, so it cannot keep a half-made table (no fences needed, TSan sees
- * every pair). Receivers are never freed (they live in the services), so a lookup that
- * follows a pointer a writer has just unlinked reads valid memory, and throws the result
- * away. A walk is bounded, so a lookup racing a stream of changes cannot loop.
+ * again under the lock. Every word a lookup reads (keys, receiver pointers, counts, the
+ * function-code summary, the masked receivers' match keys, rx_seq) is written with a release
+ * store and read with an acquire load: a lookup that sees any part of a change also sees the
+ * odd count the change began with, so it cannot keep a half-made table (no fences needed,
+ * TSan sees every pair). Receivers are never freed (they live in the services), so a lookup
+ * that follows a pointer a writer has just moved reads valid memory, and throws the result
+ * away. Every walk stays within the table's capacity.
  */
 
 #define KEY_EXT BIT(31)
 
-/* More steps than any sane table needs: a lookup that takes more retries under the lock. */
-#define RX_WALK_MAX 256
+/* Function codes of 11-bit ids: the four high bits. */
+#define FC_SHIFT 7U
+#define FC_MASK  0x780U
+#define FC_COUNT 16U
 
 #define LD_ACQ(p)    __atomic_load_n((p), __ATOMIC_ACQUIRE)
 #define ST_REL(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
@@ -281,27 +295,53 @@ static void tbl_change_end(struct co_line *line)
 	ST_REL(&line->rx_seq, line->rx_seq + 1U);
 }
 
-/*
- * Slots: one per distinct 11-bit id received, each the head of the chain of receivers of that
- * id. With CONFIG_CANOPEN_LINE_RX_INDEX a 2048-byte index gives the slot of an id at once
- * (sff[id] = 1 + slot, 0 for none); without it the ids of the used slots are kept ascending
- * and searched (binary search over CONFIG_CANOPEN_LINE_RX_SLOTS at most). Writers hold the
- * table lock; readers take none (acquire loads, see above).
- */
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
+/* The largest power of two not above the table's capacity (8 to 128). */
+#define RX_POW2                                                                                    \
+	(CONFIG_CANOPEN_LINE_RX_SLOTS >= 128  ? 128U                                               \
+	 : CONFIG_CANOPEN_LINE_RX_SLOTS >= 64 ? 64U                                                \
+	 : CONFIG_CANOPEN_LINE_RX_SLOTS >= 32 ? 32U                                                \
+	 : CONFIG_CANOPEN_LINE_RX_SLOTS >= 16 ? 16U                                                \
+					      : 8U)
+
+/* One halving of the search window: @p step is a constant, so are the steps taken. */
+#define LB_STEP(step)                                                                              \
+	do {                                                                                       \
+		if ((step) < RX_POW2) {                                                            \
+			base = (LD_ACQ(&keys[base + (step) - 1U]) < key) ? base + (step) : base;   \
+		}                                                                                  \
+	} while (false)
 
 /*
- * One table of receivers (CONFIG_CANOPEN_LINE_RX_FLAT): the n_exact exact 11-bit ones, then the
- * masked and 29-bit ones, each part in registration order, so a frame meets its receivers in
- * the order the chains below give. Every receiver carries its match key. Writers shift the
- * entries under the table lock; readers take a snapshot of the count and skip an entry a
- * writer has just cleared.
+ * The first position whose key is not below @p key (CONFIG_CANOPEN_LINE_RX_SLOTS if none), by
+ * a binary search over the whole capacity: log2(RX_POW2) + 1 comparisons, one more when the
+ * capacity is not a power of two, whatever the table holds (6 for 32 entries, 8 for 96). The
+ * steps are written out and each is a conditional move, not a branch.
  */
+static CO_HOT_INLINE unsigned int key_lower_bound(const uint16_t *keys, uint16_t key)
+{
+	unsigned int base = 0U;
+
+	/* The first RX_POW2 entries or the last: they overlap and cover the table. */
+	if (CONFIG_CANOPEN_LINE_RX_SLOTS != RX_POW2) {
+		base = (LD_ACQ(&keys[RX_POW2 - 1U]) < key) ? CONFIG_CANOPEN_LINE_RX_SLOTS - RX_POW2
+							   : 0U;
+	}
+	/* The answer is in [base, base + RX_POW2]; each step halves the window. */
+	LB_STEP(128U);
+	LB_STEP(64U);
+	LB_STEP(32U);
+	LB_STEP(16U);
+	LB_STEP(8U);
+	LB_STEP(4U);
+	LB_STEP(2U);
+	LB_STEP(1U);
+	return base + ((LD_ACQ(&keys[base]) < key) ? 1U : 0U);
+}
 
 /* Position of @p rx in the table, or -1 (writers). */
 static int rx_pos(const struct co_line *line, const struct co_rx *rx)
 {
-	for (int i = 0; i < line->n_rx; i++) {
+	for (int i = 0; i < line->rx_used; i++) {
 		if (line->rx_tab[i] == rx) {
 			return i;
 		}
@@ -309,168 +349,32 @@ static int rx_pos(const struct co_line *line, const struct co_rx *rx)
 	return -1;
 }
 
-/* Link a receiver; table lock held, between tbl_change_begin() and tbl_change_end(). */
-static int rx_tab_link(struct co_line *line, struct co_rx *rx)
+/* The bits of rx_masked_codes a masked or 29-bit receiver sets. */
+static uint32_t masked_codes_of(const struct co_rx *rx)
 {
-	int n = line->n_rx;
-	bool direct = rx_is_direct(rx);
-	int p = direct ? line->n_exact : n;
+	uint32_t codes = 0U;
 
-	if (n >= CONFIG_CANOPEN_LINE_RX_SLOTS) {
-		return -ENOSPC;
+	if ((rx->key_id & KEY_EXT) != 0U) {
+		return CO_LINE_MASKED_EXT;
 	}
-	for (int i = n; i > p; i--) {
-		ST_REL(&line->rx_tab[i], line->rx_tab[i - 1]);
-	}
-	ST_REL(&line->rx_tab[p], rx);
-	if (direct) {
-		line->n_exact++;
-	}
-	ST_REL(&line->n_rx, (uint8_t)(n + 1));
-	return 0;
-}
-
-/* Unlink a receiver; as rx_tab_link(). */
-static void rx_tab_unlink(struct co_line *line, int pos)
-{
-	int n = line->n_rx;
-
-	for (int i = pos; i + 1 < n; i++) {
-		ST_REL(&line->rx_tab[i], line->rx_tab[i + 1]);
-	}
-	ST_REL(&line->rx_tab[n - 1], NULL);
-	if (pos < line->n_exact) {
-		line->n_exact--;
-	}
-	ST_REL(&line->n_rx, (uint8_t)(n - 1));
-}
-
-#elif defined(CONFIG_CANOPEN_LINE_RX_INDEX)
-
-static int slot_of(const struct co_line *line, uint32_t id)
-{
-	return (int)line->sff[id] - 1;
-}
-
-static int slot_add(struct co_line *line, uint32_t id, struct co_rx *rx)
-{
-	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
-		if (line->slots[i] == NULL) {
-			ST_REL(&line->slots[i], rx);
-			ST_REL(&line->sff[id], (uint8_t)(i + 1));
-			return i;
+	for (uint32_t fc = 0U; fc < FC_COUNT; fc++) {
+		if ((((fc << FC_SHIFT) ^ rx->key_id) & rx->key_mask & FC_MASK) == 0U) {
+			codes |= BIT(fc);
 		}
 	}
-	return -ENOSPC;
+	return codes;
 }
 
-/* The chain of slot @p slot (of @p id) has become empty. */
-static void slot_drop(struct co_line *line, uint32_t id, int slot)
+/* Recompute rx_masked_codes from the masked part; table lock held. */
+static void masked_codes_update(struct co_line *line)
 {
-	ARG_UNUSED(slot);
-	ST_REL(&line->sff[id], 0U);
-}
+	uint32_t codes = 0U;
 
-static int slot_count(const struct co_line *line)
-{
-	return CONFIG_CANOPEN_LINE_RX_SLOTS;
-}
-
-static ALWAYS_INLINE struct co_rx *slot_head(const struct co_line *line, uint32_t id)
-{
-	uint8_t slot = LD_ACQ(&line->sff[id]);
-
-	return slot != 0U ? LD_ACQ(&line->slots[slot - 1U]) : NULL;
-}
-
-#else /* !CONFIG_CANOPEN_LINE_RX_INDEX */
-
-/* Position of the first used slot whose id is not below @p id (writers). */
-static int slot_pos(const struct co_line *line, uint32_t id)
-{
-	int lo = 0;
-	int hi = line->n_slots;
-
-	while (lo < hi) {
-		int mid = (lo + hi) / 2;
-
-		if (line->slot_ids[mid] < id) {
-			lo = mid + 1;
-		} else {
-			hi = mid;
-		}
+	for (int i = line->rx_exact; i < line->rx_used; i++) {
+		codes |= masked_codes_of(line->rx_tab[i]);
 	}
-	return lo;
+	ST_REL(&line->rx_masked_codes, codes);
 }
-
-static int slot_of(const struct co_line *line, uint32_t id)
-{
-	int p = slot_pos(line, id);
-
-	return p < line->n_slots && line->slot_ids[p] == id ? p : -1;
-}
-
-static int slot_add(struct co_line *line, uint32_t id, struct co_rx *rx)
-{
-	int n = line->n_slots;
-	int p = slot_pos(line, id);
-
-	if (n >= CONFIG_CANOPEN_LINE_RX_SLOTS) {
-		return -ENOSPC;
-	}
-	for (int i = n; i > p; i--) {
-		ST_REL(&line->slot_ids[i], line->slot_ids[i - 1]);
-		ST_REL(&line->slots[i], line->slots[i - 1]);
-	}
-	ST_REL(&line->slot_ids[p], (uint16_t)id);
-	ST_REL(&line->slots[p], rx);
-	ST_REL(&line->n_slots, (uint8_t)(n + 1));
-	return p;
-}
-
-static void slot_drop(struct co_line *line, uint32_t id, int slot)
-{
-	int n = line->n_slots;
-
-	ARG_UNUSED(id);
-	for (int i = slot; i + 1 < n; i++) {
-		ST_REL(&line->slot_ids[i], line->slot_ids[i + 1]);
-		ST_REL(&line->slots[i], line->slots[i + 1]);
-	}
-	ST_REL(&line->slots[n - 1], NULL);
-	ST_REL(&line->n_slots, (uint8_t)(n - 1));
-}
-
-static int slot_count(const struct co_line *line)
-{
-	return line->n_slots;
-}
-
-/* Readers: a binary search over a snapshot of the count, every index within the arrays. */
-static ALWAYS_INLINE struct co_rx *slot_head(const struct co_line *line, uint32_t id)
-{
-	int n = LD_ACQ(&line->n_slots);
-	int lo = 0;
-	int hi;
-
-	if (n > CONFIG_CANOPEN_LINE_RX_SLOTS) {
-		n = CONFIG_CANOPEN_LINE_RX_SLOTS;
-	}
-	hi = n;
-
-	while (lo < hi) {
-		int mid = (lo + hi) / 2;
-
-		if (LD_ACQ(&line->slot_ids[mid]) < id) {
-			lo = mid + 1;
-		} else {
-			hi = mid;
-		}
-	}
-	return lo < n && LD_ACQ(&line->slot_ids[lo]) == id ? LD_ACQ(&line->slots[lo]) : NULL;
-}
-
-#endif /* CONFIG_CANOPEN_LINE_RX_FLAT, CONFIG_CANOPEN_LINE_RX_INDEX */
 
 /*
  * rx->line changes under the table lock but is read without it: by the dispatcher, which has
@@ -490,88 +394,66 @@ static inline void rx_line_set(struct co_rx *rx, struct co_line *line)
 /* Link a receiver; table lock held, between tbl_change_begin() and tbl_change_end(). */
 static int rx_link(struct co_line *line, struct co_rx *rx)
 {
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	ST_REL(&rx->key_id, rx->id | (rx->ext ? KEY_EXT : 0U));
-	ST_REL(&rx->key_mask, rx->mask | KEY_EXT);
-	if (rx_tab_link(line, rx) < 0) {
+	int n = line->rx_used;
+	bool direct = rx_is_direct(rx);
+	uint16_t key = direct ? (uint16_t)(rx->id & SFF_MASK) : (uint16_t)CO_LINE_KEY_MASKED;
+	/* An exact receiver goes behind those of its id: they keep registration order. */
+	int p = direct ? (int)key_lower_bound(line->rx_key, (uint16_t)(key + 1U)) : n;
+
+	if (n >= CONFIG_CANOPEN_LINE_RX_SLOTS) {
 		return -ENOSPC;
 	}
-#else
-	ST_REL(&rx->next, NULL);
-	if (rx_is_direct(rx)) {
-		uint32_t id = rx->id & SFF_MASK;
-		int slot = slot_of(line, id);
-
-		if (slot < 0) {
-			if (slot_add(line, id, rx) < 0) {
-				return -ENOSPC;
-			}
-		} else {
-			/* Append, so receivers of one id see frames in registration order. */
-			struct co_rx *tail = line->slots[slot];
-
-			while (tail->next != NULL) {
-				tail = tail->next;
-			}
-			ST_REL(&tail->next, rx);
-		}
-	} else {
-		struct co_rx **pp = &line->others;
-
+	if (!direct) {
 		ST_REL(&rx->key_id, rx->id | (rx->ext ? KEY_EXT : 0U));
 		ST_REL(&rx->key_mask, rx->mask | KEY_EXT);
-		while (*pp != NULL) {
-			pp = &(*pp)->next;
-		}
-		ST_REL(pp, rx);
 	}
-#endif
+	for (int i = n; i > p; i--) {
+		ST_REL(&line->rx_key[i], line->rx_key[i - 1]);
+		ST_REL(&line->rx_tab[i], line->rx_tab[i - 1]);
+	}
+	ST_REL(&line->rx_key[p], key);
+	ST_REL(&line->rx_tab[p], rx);
+	line->rx_used = (uint8_t)(n + 1);
+	if (direct) {
+		ST_REL(&line->rx_exact, (uint8_t)(line->rx_exact + 1U));
+	} else {
+		masked_codes_update(line);
+	}
 	rx_line_set(rx, line);
 	return 0;
+}
+
+/* Unlink the receiver at @p pos; as rx_link(). */
+static void rx_unlink_at(struct co_line *line, int pos)
+{
+	struct co_rx *rx = line->rx_tab[pos];
+	int n = line->rx_used;
+
+	for (int i = pos; i + 1 < n; i++) {
+		ST_REL(&line->rx_key[i], line->rx_key[i + 1]);
+		ST_REL(&line->rx_tab[i], line->rx_tab[i + 1]);
+	}
+	ST_REL(&line->rx_key[n - 1], (uint16_t)CO_LINE_KEY_FREE);
+	ST_REL(&line->rx_tab[n - 1], NULL);
+	line->rx_used = (uint8_t)(n - 1);
+	if (pos < line->rx_exact) {
+		ST_REL(&line->rx_exact, (uint8_t)(line->rx_exact - 1U));
+	} else {
+		masked_codes_update(line);
+	}
+	rx_line_set(rx, NULL);
 }
 
 /* Unlink a receiver; as rx_link(). */
 static void rx_unlink(struct co_line *line, struct co_rx *rx)
 {
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
 	int pos = rx_pos(line, rx);
 
-	if (pos < 0) {
-		return;
-	}
-	rx_tab_unlink(line, pos);
-#else
-	struct co_rx **pp;
-
-	if (rx_is_direct(rx)) {
-		uint32_t id = rx->id & SFF_MASK;
-		int slot = slot_of(line, id);
-
-		if (slot < 0) {
-			return;
-		}
-		pp = &line->slots[slot];
-		while (*pp != NULL && *pp != rx) {
-			pp = &(*pp)->next;
-		}
-		if (*pp == rx) {
-			ST_REL(pp, rx->next);
-		}
-		if (line->slots[slot] == NULL) {
-			slot_drop(line, id, slot);
-		}
+	if (pos >= 0) {
+		rx_unlink_at(line, pos);
 	} else {
-		pp = &line->others;
-		while (*pp != NULL && *pp != rx) {
-			pp = &(*pp)->next;
-		}
-		if (*pp == rx) {
-			ST_REL(pp, rx->next);
-		}
+		rx_line_set(rx, NULL);
 	}
-	ST_REL(&rx->next, NULL);
-#endif
-	rx_line_set(rx, NULL);
 }
 
 static bool id_fits(const struct co_rx *rx, uint32_t id)
@@ -663,60 +545,42 @@ static inline bool rx_selected(const struct co_rx *rx, const struct k_mutex *loc
 
 /*
  * The receivers of a frame, in table order, into batch (the first
- * CONFIG_CANOPEN_LINE_RX_FANOUT of them). Returns how many matched, or -1 when the walk took
- * more than @p budget steps (a lookup racing changes; done again under the lock).
+ * CONFIG_CANOPEN_LINE_RX_FANOUT of them). Returns how many matched.
  */
 static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can_frame *frame,
-				    const struct k_mutex *lock, bool only, struct co_rx **batch,
-				    int budget)
+				    const struct k_mutex *lock, bool only, struct co_rx **batch)
 {
 	bool ext = (frame->flags & CAN_FRAME_IDE) != 0U;
+	uint32_t codes = LD_ACQ(&line->rx_masked_codes);
 	struct co_rx *rx;
 	int m = 0;
 
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	uint32_t key = frame->id | (ext ? KEY_EXT : 0U);
-	int n = LD_ACQ(&line->n_rx);
-
-	/* The table is bounded: no walk to cut short. */
-	ARG_UNUSED(budget);
-	if (n > CONFIG_CANOPEN_LINE_RX_SLOTS) {
-		n = CONFIG_CANOPEN_LINE_RX_SLOTS;
-	}
-	for (int i = 0; i < n; i++) {
-		rx = LD_ACQ(&line->rx_tab[i]);
-		if (rx != NULL && ((key ^ LD_ACQ(&rx->key_id)) & LD_ACQ(&rx->key_mask)) == 0U &&
-		    rx_selected(rx, lock, only)) {
-			if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
-				batch[m] = rx;
-			}
-			m++;
-		}
-	}
-#else
 	if (!ext) {
-		for (rx = slot_head(line, frame->id & SFF_MASK); rx != NULL;
-		     rx = LD_ACQ(&rx->next)) {
-			if (--budget < 0) {
-				return -1;
-			}
-			if (rx_selected(rx, lock, only)) {
+		uint16_t key = (uint16_t)(frame->id & SFF_MASK);
+
+		/* The free key behind the last entry ends the run. */
+		for (unsigned int i = key_lower_bound(line->rx_key, key);
+		     LD_ACQ(&line->rx_key[i]) == key; i++) {
+			rx = LD_ACQ(&line->rx_tab[i]);
+			if (rx != NULL && rx_selected(rx, lock, only)) {
 				if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
 					batch[m] = rx;
 				}
 				m++;
 			}
 		}
+		codes &= BIT(key >> FC_SHIFT);
+	} else {
+		codes &= CO_LINE_MASKED_EXT;
 	}
-	rx = LD_ACQ(&line->others);
-	if (rx != NULL) {
-		uint32_t key = frame->id | (ext ? KEY_EXT : 0U);
+	if (codes != 0U) {
+		uint32_t fkey = frame->id | (ext ? KEY_EXT : 0U);
 
-		for (; rx != NULL; rx = LD_ACQ(&rx->next)) {
-			if (--budget < 0) {
-				return -1;
-			}
-			if (((key ^ LD_ACQ(&rx->key_id)) & LD_ACQ(&rx->key_mask)) == 0U &&
+		for (unsigned int i = LD_ACQ(&line->rx_exact);
+		     LD_ACQ(&line->rx_key[i]) == (uint16_t)CO_LINE_KEY_MASKED; i++) {
+			rx = LD_ACQ(&line->rx_tab[i]);
+			if (rx != NULL &&
+			    ((fkey ^ LD_ACQ(&rx->key_id)) & LD_ACQ(&rx->key_mask)) == 0U &&
 			    rx_selected(rx, lock, only)) {
 				if (m < CONFIG_CANOPEN_LINE_RX_FANOUT) {
 					batch[m] = rx;
@@ -725,7 +589,6 @@ static CO_HOT_INLINE int rx_collect(const struct co_line *line, const struct can
 			}
 		}
 	}
-#endif
 	return m;
 }
 
@@ -742,7 +605,7 @@ static __attribute__((noinline)) int rx_collect_again(struct co_line *line,
 	int m;
 
 	k_mutex_lock(&line->lock, K_FOREVER);
-	m = rx_collect(line, frame, lock, only, batch, INT_MAX);
+	m = rx_collect(line, frame, lock, only, batch);
 	k_mutex_unlock(&line->lock);
 	return m;
 }
@@ -765,28 +628,31 @@ static inline void stat_inc(uint32_t *counter)
 }
 
 /*
- * A frame from the bus. With CONFIG_CANOPEN_LINE_RX_SHORTCUT the common case, one receiver
- * for an 11-bit id and no masked or 29-bit receivers on the line, is looked up and called
- * here; anything else (everything without the option) goes through co_line_dispatch_sel(),
- * which does the same in more steps.
+ * A frame from the bus. The common case, an 11-bit id with one exact receiver and no masked
+ * receiver that could match it, is called from here on the same lookup, without a batch; any
+ * other frame goes through co_line_dispatch_sel(), which collects its receivers first.
  */
 int co_line_rx(struct co_line *line, const struct can_frame *frame, uint64_t now_us)
 {
-#if defined(CONFIG_CANOPEN_LINE_RX_SHORTCUT)
 	uint32_t seq = LD_ACQ(&line->rx_seq);
+	uint16_t key = (uint16_t)(frame->id & SFF_MASK);
 
-	if (likely((frame->flags & CAN_FRAME_IDE) == 0U && (seq & 1U) == 0U)) {
-		struct co_rx *rx = slot_head(line, frame->id & SFF_MASK);
+	if (likely((frame->flags & CAN_FRAME_IDE) == 0U && (seq & 1U) == 0U &&
+		   (LD_ACQ(&line->rx_masked_codes) & BIT(key >> FC_SHIFT)) == 0U)) {
+		unsigned int i = key_lower_bound(line->rx_key, key);
 
-		if (rx != NULL && LD_ACQ(&rx->next) == NULL && LD_ACQ(&line->others) == NULL &&
-		    LD_ACQ(&line->rx_seq) == seq) {
-			sim_advance(line, now_us);
-			stat_inc(&line->stats.rx_frames);
-			rx_call(line, rx, frame, now_us);
-			return 1;
+		/* The free key behind the last entry: i + 1 stays inside rx_key. */
+		if (LD_ACQ(&line->rx_key[i]) == key && LD_ACQ(&line->rx_key[i + 1U]) != key) {
+			struct co_rx *rx = LD_ACQ(&line->rx_tab[i]);
+
+			if (rx != NULL && LD_ACQ(&line->rx_seq) == seq) {
+				sim_advance(line, now_us);
+				stat_inc(&line->stats.rx_frames);
+				rx_call(line, rx, frame, now_us);
+				return 1;
+			}
 		}
 	}
-#endif
 	return co_line_dispatch_sel(line, frame, now_us, NULL, false);
 }
 
@@ -809,7 +675,7 @@ int co_line_dispatch_sel(struct co_line *line, const struct can_frame *frame, ui
 
 	sim_advance(line, now_us);
 	if (likely((seq & 1U) == 0U)) {
-		n = rx_collect(line, frame, lock, only, batch, RX_WALK_MAX);
+		n = rx_collect(line, frame, lock, only, batch);
 	}
 	if (unlikely(n < 0 || LD_ACQ(&line->rx_seq) != seq)) {
 		n = rx_collect_again(line, frame, lock, only, batch);
@@ -839,22 +705,102 @@ void co_timer_init(struct co_timer *timer, co_timer_handler_t handler, struct k_
 	timer->handler = handler;
 	timer->lock = lock;
 	timer->user_data = user_data;
+	timer->slot = CO_TIMER_UNARMED;
 }
 
 /*
- * Whether a timer is in its line's list: every removal (sys_slist_remove()) and the insert at
- * the tail clear node.next, so outside the list it is NULL, as for the last timer in it.
+ * Armed timers: a binary min-heap per line (line->timers[0..n_timers-1]), each timer knowing
+ * its place (slot), so a start or stop costs O(log n) and the next deadline is timers[0].
+ * Equal deadlines keep arming order through the timer's arming number (seq).
  */
+
+/* Whether @p a runs before @p b: earlier deadline, or the same one and armed earlier. */
+static bool timer_before(const struct co_timer *a, const struct co_timer *b)
+{
+	if (a->deadline != b->deadline) {
+		return co_time_before_eq(a->deadline, b->deadline);
+	}
+	return (int32_t)(a->seq - b->seq) < 0;
+}
+
+static void heap_put(struct co_line *line, struct co_timer *t, unsigned int i)
+{
+	line->timers[i] = t;
+	t->slot = (uint16_t)i;
+}
+
+/* Move the timer at @p i towards the root while it runs before its parent. */
+static void heap_up(struct co_line *line, unsigned int i)
+{
+	struct co_timer *t = line->timers[i];
+
+	while (i > 0U) {
+		unsigned int parent = (i - 1U) / 2U;
+
+		if (!timer_before(t, line->timers[parent])) {
+			break;
+		}
+		heap_put(line, line->timers[parent], i);
+		i = parent;
+	}
+	heap_put(line, t, i);
+}
+
+/* Move the timer at @p i towards the leaves while a child runs before it. */
+static void heap_down(struct co_line *line, unsigned int i)
+{
+	struct co_timer *t = line->timers[i];
+	unsigned int n = line->n_timers;
+
+	for (;;) {
+		unsigned int c = 2U * i + 1U;
+
+		if (c >= n) {
+			break;
+		}
+		if (c + 1U < n && timer_before(line->timers[c + 1U], line->timers[c])) {
+			c++;
+		}
+		if (!timer_before(line->timers[c], t)) {
+			break;
+		}
+		heap_put(line, line->timers[c], i);
+		i = c;
+	}
+	heap_put(line, t, i);
+}
+
+/* Take an armed timer out of the heap: the last one fills its place and moves up or down. */
+static void heap_remove(struct co_line *line, struct co_timer *t)
+{
+	unsigned int i = t->slot;
+	unsigned int last = line->n_timers - 1U;
+
+	t->slot = CO_TIMER_UNARMED;
+	line->n_timers = (uint16_t)last;
+	if (i != last) {
+		struct co_timer *moved = line->timers[last];
+
+		heap_put(line, moved, i);
+		if (i > 0U && timer_before(moved, line->timers[(i - 1U) / 2U])) {
+			heap_up(line, i);
+		} else {
+			heap_down(line, i);
+		}
+	}
+	line->timers[last] = NULL;
+}
+
+/* Whether a timer is in its line's heap (line lock held). */
 static bool timer_armed(const struct co_line *line, const struct co_timer *timer)
 {
-	return sys_slist_peek_next_no_check(&timer->node) != NULL ||
-	       sys_slist_peek_tail(&line->timers) == &timer->node;
+	return timer->line == line && timer->slot != CO_TIMER_UNARMED;
 }
 
 static void timer_unlink(struct co_line *line, struct co_timer *timer)
 {
 	if (timer_armed(line, timer)) {
-		(void)sys_slist_find_and_remove(&line->timers, &timer->node);
+		heap_remove(line, timer);
 	}
 	/* Any start or stop makes the timer stale if co_line_process() has just taken it. */
 	if (line->popped == timer) {
@@ -862,12 +808,19 @@ static void timer_unlink(struct co_line *line, struct co_timer *timer)
 	}
 }
 
+/* The heap is full: the timer stays disarmed, counted and logged (the first time). */
+static __attribute__((noinline)) void timer_overflow(struct co_line *line)
+{
+	if (line->stats.timer_overflows++ == 0U) {
+		LOG_ERR("%s: more than %d timers armed; raise CONFIG_CANOPEN_LINE_TIMERS",
+			line->name, CONFIG_CANOPEN_LINE_TIMERS);
+	}
+}
+
 void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadline_us)
 {
 	struct co_line *old = timer->line;
-	sys_snode_t *prev = NULL;
-	sys_snode_t *cur;
-	bool first;
+	bool first = false;
 
 	if (old != NULL && old != line) {
 		co_timer_stop(timer);
@@ -876,17 +829,17 @@ void co_timer_start(struct co_line *line, struct co_timer *timer, uint64_t deadl
 	timer_unlink(line, timer);
 	timer->deadline = deadline_us;
 	timer->line = line;
-	/* Sorted insert; equal deadlines keep arming order. */
-	SYS_SLIST_FOR_EACH_NODE(&line->timers, cur) {
-		struct co_timer *t = CONTAINER_OF(cur, struct co_timer, node);
-
-		if (!co_time_before_eq(t->deadline, deadline_us)) {
-			break;
-		}
-		prev = cur;
+	if (line->n_timers < CONFIG_CANOPEN_LINE_TIMERS) {
+		timer->seq = line->timer_seq++;
+		heap_put(line, timer, line->n_timers);
+		line->n_timers++;
+		heap_up(line, timer->slot);
+		first = (timer->slot == 0U);
+	} else {
+		/* Not armed, whatever a zeroed timer's slot said. */
+		timer->slot = CO_TIMER_UNARMED;
+		timer_overflow(line);
 	}
-	sys_slist_insert(&line->timers, prev, &timer->node);
-	first = (prev == NULL);
 	k_mutex_unlock(&line->lock);
 
 	if (first) {
@@ -923,34 +876,25 @@ bool co_timer_is_armed(const struct co_timer *timer)
 uint64_t co_line_next_deadline(struct co_line *line)
 {
 	uint64_t next = UINT64_MAX;
-	sys_snode_t *head;
 
 	k_mutex_lock(&line->lock, K_FOREVER);
-	head = sys_slist_peek_head(&line->timers);
-	if (head != NULL) {
-		next = CONTAINER_OF(head, struct co_timer, node)->deadline;
+	if (line->n_timers > 0U) {
+		next = line->timers[0]->deadline;
 	}
 	k_mutex_unlock(&line->lock);
 	return next;
 }
 
-/* Take the first expired timer off the list, or return NULL. */
+/* Take the first expired timer out of the heap, or return NULL. */
 static struct co_timer *timer_pop_expired(struct co_line *line, uint64_t now_us)
 {
 	struct co_timer *t = NULL;
-	sys_snode_t *head;
 
 	k_mutex_lock(&line->lock, K_FOREVER);
-	head = sys_slist_peek_head(&line->timers);
-	if (head != NULL) {
-		struct co_timer *first = CONTAINER_OF(head, struct co_timer, node);
-
-		if (co_time_before_eq(first->deadline, now_us)) {
-			/* Not sys_slist_get(): Zephyr's leaves node.next as it was. */
-			sys_slist_remove(&line->timers, NULL, head);
-			line->popped = first;
-			t = first;
-		}
+	if (line->n_timers > 0U && co_time_before_eq(line->timers[0]->deadline, now_us)) {
+		t = line->timers[0];
+		heap_remove(line, t);
+		line->popped = t;
 	}
 	k_mutex_unlock(&line->lock);
 	return t;
@@ -1196,42 +1140,21 @@ int co_line_attach(struct co_line *line, struct co_line_member *m, const struct 
 /* Drop every receiver and timer of one owner (a node leaving the line). */
 static void purge_owner(struct co_line *line, const struct k_mutex *lock)
 {
-#if defined(CONFIG_CANOPEN_LINE_RX_FLAT)
-	/* From the top: rx_unlink() moves the entries above down. */
-	for (int i = line->n_rx - 1; i >= 0; i--) {
-		struct co_rx *rx = line->rx_tab[i];
+	/* From the top: rx_unlink_at() moves the entries above down. */
+	for (int i = line->rx_used - 1; i >= 0; i--) {
+		if (line->rx_tab[i]->lock == lock) {
+			rx_unlink_at(line, i);
+		}
+	}
+	/* From the start again after each removal: the heap moves timers around. */
+	for (unsigned int i = 0U; i < line->n_timers;) {
+		struct co_timer *t = line->timers[i];
 
-		if (rx->lock == lock) {
-			rx_tab_unlink(line, i);
-			rx_line_set(rx, NULL);
-		}
-	}
-#else
-	/*
-	 * The used slots hold every exact 11-bit receiver; rx_unlink() frees emptied ones (and
-	 * without the index moves the slots above down: hence from the top).
-	 */
-	for (int i = slot_count(line) - 1; i >= 0; i--) {
-		for (struct co_rx *rx = line->slots[i], *next; rx != NULL; rx = next) {
-			next = rx->next;
-			if (rx->lock == lock) {
-				rx_unlink(line, rx);
-			}
-		}
-	}
-	for (struct co_rx *rx = line->others, *next; rx != NULL; rx = next) {
-		next = rx->next;
-		if (rx->lock == lock) {
-			rx_unlink(line, rx);
-		}
-	}
-#endif
-	struct co_timer *t;
-	struct co_timer *tn;
-
-	SYS_SLIST_FOR_EACH_CONTAINER_SAFE(&line->timers, t, tn, node) {
 		if (t->lock == lock) {
 			timer_unlink(line, t);
+			i = 0U;
+		} else {
+			i++;
 		}
 	}
 }
@@ -1378,4 +1301,7 @@ void co_line_get_stats(struct co_line *line, struct co_line_stats *stats)
 	stats->rx_unhandled = __atomic_load_n(&line->stats.rx_unhandled, __ATOMIC_RELAXED);
 	stats->rx_fanout_drops = __atomic_load_n(&line->stats.rx_fanout_drops, __ATOMIC_RELAXED);
 	stats->rx_overruns = __atomic_load_n(&line->stats.rx_overruns, __ATOMIC_RELAXED);
+	k_mutex_lock(&line->lock, K_FOREVER);
+	stats->timer_overflows = line->stats.timer_overflows;
+	k_mutex_unlock(&line->lock);
 }

@@ -111,9 +111,8 @@ def test_three_configurations_measured(tmp_path):
         assert c["stack"]["code"] > 10000
         assert c["ram"]["per_line"] > 0 and c["ram"]["per_node"] > 0
         assert "stubs.c" not in " ".join(files), "the stubs are not the stack's"
-        # Embedded defaults: the flat receive table, which leaves the 2 KiB index out.
-        assert c["kconfig"]["CONFIG_CANOPEN_LINE_RX_FLAT"] == "y", "embedded defaults"
-        assert c["kconfig"].get("CONFIG_CANOPEN_LINE_RX_INDEX", "n") == "n", "embedded defaults"
+        # Embedded defaults: a target's receive table (32 entries), not the native board's.
+        assert c["kconfig"]["CONFIG_CANOPEN_LINE_RX_SLOTS"] in ("16", "32"), "embedded defaults"
     assert "per_rpdo" in configs["minimal"]["ram"] and "per_sdo_srv" in configs["minimal"]["ram"]
     assert "subsys/canopen/pdo/mpdo.c" not in {f["file"] for f in configs["minimal"]["files"]}
     # The minimal slave leaves out the OD's providers and hook-coverage cache; the others keep

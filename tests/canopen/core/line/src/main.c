@@ -186,8 +186,7 @@ ZTEST(co_line, test_unregister_stops_delivery_and_frees_the_slot)
 
 /*
  * Ids registered in any order, some removed from the middle and moved: each frame reaches the
- * receivers of its id and no other (with or without CONFIG_CANOPEN_LINE_RX_INDEX, which keeps
- * the used ids sorted and searches them).
+ * receivers of its id and no other (the table keeps them sorted and searches them).
  */
 /* A multiple of three: the test takes the receivers three by three. */
 #define SPREAD_N (MIN(24, CONFIG_CANOPEN_LINE_RX_SLOTS) / 3 * 3)
@@ -279,8 +278,8 @@ ZTEST(co_line, test_masked_and_extended_receivers)
 
 /*
  * A frame meets the exact 11-bit receivers of its id first, then the masked ones, each kind in
- * registration order; a receiver registered again or moved goes to the end of its kind. With
- * CONFIG_CANOPEN_LINE_RX_FLAT one table holds both kinds, and this order is its layout.
+ * registration order; a receiver registered again or moved goes to the end of its kind. One
+ * table holds both kinds, and this order is its layout.
  */
 ZTEST(co_line, test_exact_receivers_come_before_masked_ones)
 {
@@ -317,28 +316,187 @@ ZTEST(co_line, test_exact_receivers_come_before_masked_ones)
 }
 
 /*
- * CONFIG_CANOPEN_LINE_RX_SLOTS counts distinct 11-bit ids, or with CONFIG_CANOPEN_LINE_RX_FLAT
- * receivers of any kind: that many on one id leave no room for a masked one there.
+ * CONFIG_CANOPEN_LINE_RX_SLOTS counts receivers of any kind: that many on one id leave no room
+ * for a masked one, nor for a 29-bit one.
  */
-ZTEST(co_line, test_slots_count_receivers_only_in_the_flat_table)
+ZTEST(co_line, test_every_receiver_takes_an_entry)
 {
 	static struct co_rx rx[CONFIG_CANOPEN_LINE_RX_SLOTS];
-	struct co_rx masked;
-	bool flat = IS_ENABLED(CONFIG_CANOPEN_LINE_RX_FLAT);
+	struct co_rx masked, ext;
 
 	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
 		rx_fill(&rx[i], 0x181, 0x7ff, false, i);
 		zassert_ok(co_rx_register(&fx.line, &rx[i]), "receiver %d", i);
 	}
 	rx_fill(&masked, 0x100, 0x700, false, 99);
-	zassert_equal(co_rx_register(&fx.line, &masked), flat ? -ENOSPC : 0);
+	rx_fill(&ext, 0x1234, 0x1fffffff, true, 98);
+	zassert_equal(co_rx_register(&fx.line, &masked), -ENOSPC);
+	zassert_equal(co_rx_register(&fx.line, &ext), -ENOSPC);
+	zassert_is_null(masked.line, "a refused receiver is not registered");
 	co_rx_unregister(&rx[0]);
-	co_rx_unregister(&masked);
 	zassert_ok(co_rx_register(&fx.line, &masked), "room after one receiver left");
+	zassert_equal(co_rx_register(&fx.line, &ext), -ENOSPC);
 	co_rx_unregister(&masked);
 	for (int i = 0; i < CONFIG_CANOPEN_LINE_RX_SLOTS; i++) {
 		co_rx_unregister(&rx[i]);
 	}
+	zassert_ok(co_rx_register(&fx.line, &ext), "an empty table again");
+	co_rx_unregister(&ext);
+}
+
+/* Receivers a test looks up, and the frames it sends them. */
+#define PROBE_N   6
+#define CROWD_N   42
+#define CROWD_MIN (PROBE_N + CROWD_N + 1)
+
+/* The tags a frame of @p id reached, in order, as a number (one decimal digit per receiver). */
+static int rx_tags(uint32_t id)
+{
+	struct can_frame f = std_frame(id, 0);
+	int tags = 0;
+
+	fx.log_len = 0;
+	co_line_rx(&fx.line, &f, 0);
+	for (int i = 0; i < fx.log_len; i++) {
+		tags = tags * 10 + fx.log[i];
+	}
+	return tags;
+}
+
+/*
+ * The per-frame lookup finds the same receivers, in the same order, with six receivers on the
+ * line, with 42 more exact ones on ids around theirs (below, between and above, which move
+ * theirs up the table) and with a masked one beside them: a receiver's id is found by the
+ * search, whatever else the table holds.
+ */
+ZTEST(co_line, test_lookup_finds_the_same_receivers_however_full_the_table)
+{
+	static struct co_rx probe[PROBE_N], crowd[CROWD_N];
+	struct co_rx masked;
+	/* Two of 181h, one each of 000h, 201h, 7ffh and 702h (registration order: tags 1..6). */
+	const uint32_t probe_id[PROBE_N] = {0x181, 0x000, 0x7ff, 0x181, 0x201, 0x702};
+	const uint32_t probe_expect[][2] = {
+		{0x181, 14}, {0x000, 2}, {0x7ff, 3}, {0x201, 5}, {0x702, 6}, {0x182, 0}, {0x703, 0},
+	};
+
+	if (CONFIG_CANOPEN_LINE_RX_SLOTS < CROWD_MIN) {
+		ztest_test_skip();
+	}
+	for (int i = 0; i < PROBE_N; i++) {
+		rx_fill(&probe[i], probe_id[i], 0x7ff, false, i + 1);
+		zassert_ok(co_rx_register(&fx.line, &probe[i]));
+	}
+	for (size_t k = 0; k < ARRAY_SIZE(probe_expect); k++) {
+		zassert_equal(rx_tags(probe_expect[k][0]), (int)probe_expect[k][1], "alone: %03x",
+			      probe_expect[k][0]);
+	}
+
+	/* The crowd: ids 1..7feh not used by the probes, spread over the range, not in order. */
+	for (int i = 0; i < CROWD_N; i++) {
+		uint32_t id = 1U + ((uint32_t)i * 977U) % 0x7fdU;
+
+		if (id == 0x181 || id == 0x201 || id == 0x702 || id == 0x182 || id == 0x703) {
+			id ^= 0x400U;
+		}
+		rx_fill(&crowd[i], id, 0x7ff, false, 9);
+		zassert_ok(co_rx_register(&fx.line, &crowd[i]), "crowd %d", i);
+	}
+	for (size_t k = 0; k < ARRAY_SIZE(probe_expect); k++) {
+		zassert_equal(rx_tags(probe_expect[k][0]), (int)probe_expect[k][1], "crowd: %03x",
+			      probe_expect[k][0]);
+	}
+	for (int i = 0; i < CROWD_N; i++) {
+		zassert_equal(rx_tags(crowd[i].id) % 10, 9, "crowd receiver %d", i);
+	}
+
+	/* A masked receiver of the heartbeat range (700h-77Fh): after 702h's exact one. */
+	rx_fill(&masked, 0x700, 0x780, false, 7);
+	zassert_ok(co_rx_register(&fx.line, &masked));
+	zassert_equal(rx_tags(0x702), 67);
+	zassert_equal(rx_tags(0x703), 7);
+	zassert_equal(rx_tags(0x7ff), 3, "780h-7FFh is outside the mask");
+	zassert_equal(rx_tags(0x181), 14);
+	zassert_equal(rx_tags(0x000), 2);
+	zassert_equal(rx_tags(0x201), 5);
+
+	co_rx_unregister(&masked);
+	for (int i = 0; i < CROWD_N; i++) {
+		co_rx_unregister(&crowd[i]);
+	}
+	for (size_t k = 0; k < ARRAY_SIZE(probe_expect); k++) {
+		zassert_equal(rx_tags(probe_expect[k][0]), (int)probe_expect[k][1], "after: %03x",
+			      probe_expect[k][0]);
+	}
+	for (int i = 0; i < PROBE_N; i++) {
+		co_rx_unregister(&probe[i]);
+	}
+	zassert_equal(fx.line.rx_used, 0);
+}
+
+/*
+ * Receivers of one id stay in registration order while receivers of lower ids join and leave
+ * (which moves the whole run up and down the table), and a receiver of that id registered
+ * after them comes last.
+ */
+ZTEST(co_line, test_receivers_of_one_id_keep_registration_order_as_the_table_moves)
+{
+	struct co_rx same[3], low[3], late;
+
+	for (int i = 0; i < 3; i++) {
+		rx_fill(&same[i], 0x300, 0x7ff, false, i + 1);
+		rx_fill(&low[i], 0x100 + (uint32_t)i, 0x7ff, false, 8);
+	}
+	rx_fill(&late, 0x300, 0x7ff, false, 4);
+	zassert_ok(co_rx_register(&fx.line, &same[0]));
+	zassert_ok(co_rx_register(&fx.line, &low[2]));
+	zassert_ok(co_rx_register(&fx.line, &same[1]));
+	zassert_ok(co_rx_register(&fx.line, &low[0]));
+	zassert_ok(co_rx_register(&fx.line, &same[2]));
+	zassert_equal(rx_tags(0x300), 123);
+	co_rx_unregister(&low[2]);
+	zassert_ok(co_rx_register(&fx.line, &low[1]));
+	zassert_ok(co_rx_register(&fx.line, &late));
+	zassert_equal(rx_tags(0x300), 1234);
+	co_rx_unregister(&same[1]);
+	zassert_equal(rx_tags(0x300), 134);
+	zassert_equal(rx_tags(0x100), 8);
+	zassert_equal(rx_tags(0x101), 8);
+	zassert_equal(rx_tags(0x102), 0);
+}
+
+/*
+ * The line's summary of its masked part names the function codes (id >> 7) its masked 11-bit
+ * receivers can match, and 29-bit receivers with a bit of their own, and follows every change:
+ * frames of other codes do not walk the masked receivers.
+ */
+ZTEST(co_line, test_masked_summary_names_the_codes_masked_receivers_can_match)
+{
+	struct co_rx hb, lss, any, ext;
+
+	zassert_equal(fx.line.rx_masked_codes, 0U);
+	rx_fill(&hb, 0x700, 0x780, false, 1);
+	zassert_ok(co_rx_register(&fx.line, &hb));
+	zassert_equal(fx.line.rx_masked_codes, BIT(0x700 >> 7), "heartbeats: code 14 only");
+	rx_fill(&lss, 0x7e0, 0x7f0, false, 2);
+	zassert_ok(co_rx_register(&fx.line, &lss));
+	zassert_equal(fx.line.rx_masked_codes, BIT(14) | BIT(15));
+	rx_fill(&ext, 0x12345, 0x1fffff00, true, 3);
+	zassert_ok(co_rx_register(&fx.line, &ext));
+	zassert_equal(fx.line.rx_masked_codes, BIT(14) | BIT(15) | CO_LINE_MASKED_EXT);
+	co_rx_unregister(&hb);
+	zassert_equal(fx.line.rx_masked_codes, BIT(15) | CO_LINE_MASKED_EXT);
+	/* The low bits of a mask say nothing of the code: every 11-bit id. */
+	rx_fill(&any, 0x005, 0x00f, false, 4);
+	zassert_ok(co_rx_register(&fx.line, &any));
+	zassert_equal(fx.line.rx_masked_codes, 0xffffU | CO_LINE_MASKED_EXT);
+	zassert_ok(co_rx_set_id(&fx.line, &any, 0x005), "moved within the masked part");
+	zassert_equal(fx.line.rx_masked_codes, 0xffffU | CO_LINE_MASKED_EXT);
+	co_rx_unregister(&any);
+	co_rx_unregister(&ext);
+	zassert_equal(fx.line.rx_masked_codes, BIT(15));
+	zassert_equal(rx_tags(0x7e5), 2);
+	co_rx_unregister(&lss);
+	zassert_equal(fx.line.rx_masked_codes, 0U);
 }
 
 ZTEST(co_line, test_set_id_moves_a_receiver)
@@ -461,6 +619,115 @@ ZTEST(co_line, test_a_timer_is_armed_wherever_it_is_in_the_list)
 	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
 	zassert_false(armed_in_handler, "not armed while its handler runs");
 	zassert_equal(b.fired, 1, "the next one still runs");
+}
+
+/* Deadlines of the heap tests: not in order, with repeats (equal ones keep arming order). */
+#define HEAP_N 15
+static const uint16_t heap_deadline[HEAP_N] = {700, 300,  900, 300, 100, 800, 500, 300,
+					       200, 1000, 600, 100, 400, 900, 300};
+
+static struct tagged_timer heap_timers[HEAP_N];
+
+static void heap_arm_all(void)
+{
+	for (int i = 0; i < HEAP_N; i++) {
+		heap_timers[i] = (struct tagged_timer){.tag = i};
+		co_timer_init(&heap_timers[i].t, timer_handler, &fx.node_lock, NULL);
+		co_timer_start(&fx.line, &heap_timers[i].t, heap_deadline[i]);
+	}
+}
+
+/* Whether the log holds the timers in deadline order, equal deadlines in tag order. */
+static void assert_log_in_order(int n)
+{
+	for (int i = 1; i < n; i++) {
+		uint16_t a = heap_deadline[fx.log[i - 1]];
+		uint16_t b = heap_deadline[fx.log[i]];
+
+		zassert_true(a < b || (a == b && fx.log[i - 1] < fx.log[i]), "position %d: %d, %d",
+			     i, fx.log[i - 1], fx.log[i]);
+	}
+}
+
+/* Fifteen timers armed out of order run by deadline, equal deadlines in arming order. */
+ZTEST(co_line, test_timer_heap_runs_by_deadline_then_arming_order)
+{
+	heap_arm_all();
+	zassert_equal(co_line_next_deadline(&fx.line), 100);
+	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
+	zassert_equal(fx.log_len, HEAP_N);
+	assert_log_in_order(HEAP_N);
+	zassert_equal(fx.log[0], 4, "first of the two at 100");
+	zassert_equal(fx.log[1], 11);
+}
+
+/*
+ * Timers stopped from the middle of the heap and from its end, and timers restarted earlier
+ * and later, leave the others in order: each runs once at its new deadline or not at all.
+ */
+ZTEST(co_line, test_timer_heap_stop_and_restart_in_the_middle)
+{
+	/* Stopped: 6 (500), 2 (900) and 14 (the last armed); restarted: 9 to 50, 4 to 950. */
+	heap_arm_all();
+	co_timer_stop(&heap_timers[6].t);
+	co_timer_stop(&heap_timers[2].t);
+	co_timer_stop(&heap_timers[14].t);
+	co_timer_start(&fx.line, &heap_timers[9].t, 50);
+	co_timer_start(&fx.line, &heap_timers[4].t, 950);
+	zassert_equal(co_line_next_deadline(&fx.line), 50);
+	zassert_false(co_timer_is_armed(&heap_timers[6].t));
+	zassert_equal(co_line_process(&fx.line, 60), 100);
+	zassert_equal(fx.log_len, 1);
+	zassert_equal(fx.log[0], 9, "restarted earlier");
+	zassert_equal(co_line_process(&fx.line, 900), 950);
+	zassert_equal(co_line_process(&fx.line, 2000), UINT64_MAX);
+	zassert_equal(fx.log_len, HEAP_N - 3);
+	zassert_equal(fx.log[HEAP_N - 4], 4, "restarted later: last");
+	for (int i = 0; i < fx.log_len; i++) {
+		zassert_true(fx.log[i] != 6 && fx.log[i] != 2 && fx.log[i] != 14, "stopped %d ran",
+			     fx.log[i]);
+	}
+	/* Between the first (9) and the last (4), the rest in order. */
+	for (int i = 2; i < HEAP_N - 4; i++) {
+		uint16_t a = heap_deadline[fx.log[i - 1]];
+		uint16_t b = heap_deadline[fx.log[i]];
+
+		zassert_true(a < b || (a == b && fx.log[i - 1] < fx.log[i]), "position %d", i);
+	}
+}
+
+/*
+ * A line arms CONFIG_CANOPEN_LINE_TIMERS timers at once; one more stays disarmed, counted and
+ * logged, and the others are unharmed. Once one has run there is room again.
+ */
+ZTEST(co_line, test_timer_heap_full_leaves_the_timer_disarmed_and_counts_it)
+{
+	static struct tagged_timer t[CONFIG_CANOPEN_LINE_TIMERS + 1];
+	struct co_line_stats st;
+
+	for (int i = 0; i <= CONFIG_CANOPEN_LINE_TIMERS; i++) {
+		t[i] = (struct tagged_timer){.tag = i};
+		co_timer_init(&t[i].t, timer_handler, &fx.node_lock, NULL);
+	}
+	for (int i = 0; i < CONFIG_CANOPEN_LINE_TIMERS; i++) {
+		co_timer_start(&fx.line, &t[i].t, 1000U + (uint64_t)i);
+	}
+	co_timer_start(&fx.line, &t[CONFIG_CANOPEN_LINE_TIMERS].t, 10);
+	zassert_false(co_timer_is_armed(&t[CONFIG_CANOPEN_LINE_TIMERS].t));
+	co_timer_stop(&t[CONFIG_CANOPEN_LINE_TIMERS].t); /* harmless */
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.timer_overflows, 1);
+	zassert_equal(co_line_next_deadline(&fx.line), 1000, "the others are unharmed");
+	zassert_true(co_timer_is_armed(&t[0].t));
+
+	zassert_equal(co_line_process(&fx.line, 1000), 1001);
+	co_timer_start(&fx.line, &t[CONFIG_CANOPEN_LINE_TIMERS].t, 1000);
+	zassert_true(co_timer_is_armed(&t[CONFIG_CANOPEN_LINE_TIMERS].t), "room again");
+	zassert_equal(co_line_process(&fx.line, 5000), UINT64_MAX);
+	zassert_equal(fx.log_len, CONFIG_CANOPEN_LINE_TIMERS + 1);
+	zassert_equal(fx.log[1], CONFIG_CANOPEN_LINE_TIMERS, "at 1000: before 1001");
+	co_line_get_stats(&fx.line, &st);
+	zassert_equal(st.timer_overflows, 1);
 }
 
 static K_THREAD_STACK_DEFINE(processor_stack, 4096);
@@ -642,9 +909,8 @@ ZTEST(co_line, test_receivers_beyond_the_fanout_are_counted)
 	struct can_frame f = std_frame(0x080, 0);
 	struct co_line_stats st;
 
-	/* A flat table of fewer receivers cannot exceed the fanout (minimal_tables: 16 and 16). */
-	if (IS_ENABLED(CONFIG_CANOPEN_LINE_RX_FLAT) &&
-	    CONFIG_CANOPEN_LINE_RX_SLOTS < (int)ARRAY_SIZE(rx)) {
+	/* A table of fewer receivers cannot exceed the fanout (minimal_tables: 16 and 16). */
+	if (CONFIG_CANOPEN_LINE_RX_SLOTS < (int)ARRAY_SIZE(rx)) {
 		ztest_test_skip();
 	}
 	for (int i = 0; i < (int)ARRAY_SIZE(rx); i++) {
