@@ -22,6 +22,7 @@
 
 #include <zephyr/device.h>
 #include <zephyr/drivers/can.h>
+#include <zephyr/sys/byteorder.h>
 #include <zephyr/ztest.h>
 
 #include <can_virtual.h>
@@ -252,14 +253,15 @@ static uint8_t reg1001(void)
 
 static uint32_t od_u32(uint16_t index, uint8_t sub)
 {
-	uint32_t v = 0;
+	/* co_od_read() gives the wire bytes (little-endian), whatever the host's byte order. */
+	uint8_t v[4] = {0};
 	size_t len = 0;
 
 	co_node_lock(&t.node);
-	zassert_equal(co_od_read(co_node_od(&t.node), index, sub, 0, &v, 4, &len, CO_OD_WRITER_APP),
+	zassert_equal(co_od_read(co_node_od(&t.node), index, sub, 0, v, 4, &len, CO_OD_WRITER_APP),
 		      0U);
 	co_node_unlock(&t.node);
-	return v;
+	return sys_get_le32(v);
 }
 
 static uint8_t od_u8(uint16_t index, uint8_t sub)

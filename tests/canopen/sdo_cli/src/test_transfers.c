@@ -328,9 +328,12 @@ ZTEST(sdo_cli_transfers, test_block_download_leaves_room_for_the_heartbeat)
 	uint64_t start, end, prev = 0, hb_at[64];
 	uint32_t n_hb = 0, n_seg = 0, max_seq = 0, last_seq = 0;
 	size_t len;
+	uint8_t hb_le[2];
 
 	BUILD_ASSERT(CONFIG_CANOPEN_LINE_TX_QUEUE_SIZE < 128, "a sub-block must not fit the queue");
-	zassert_equal(h_od_write(&h.cnode, 0x1017, 0, &hb_ms, 2, CO_OD_WRITER_APP), 0U);
+	/* The dictionary takes wire bytes: little-endian on any host. */
+	sys_put_le16(hb_ms, hb_le);
+	zassert_equal(h_od_write(&h.cnode, 0x1017, 0, hb_le, 2, CO_OD_WRITER_APP), 0U);
 	h_advance(1 * MS);
 	h_fill(out, DOM_SIZE, 91);
 	h.bus_paced = true;
