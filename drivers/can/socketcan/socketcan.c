@@ -362,16 +362,18 @@ static int sc_program_filters_locked(struct sc_data *d)
 
 	for (int i = 0; i < SC_MAX_FILTERS; i++) {
 		if (d->rx_kf[i].used) {
-			d->kf_scratch[n++] = d->rx_kf[i].f;
+			d->kf_scratch[n] = d->rx_kf[i].f;
+			n++;
 		}
 	}
 	for (int i = 0; i < SC_TX_IDS; i++) {
 		if (d->tx_ids[i].used) {
-			d->kf_scratch[n++] = (struct socketcan_host_filter){
+			d->kf_scratch[n] = (struct socketcan_host_filter){
 				.id = d->tx_ids[i].id,
 				.mask = UINT32_MAX,
 				.flags = d->tx_ids[i].flags,
 			};
+			n++;
 		}
 	}
 	rc = socketcan_host_set_filters(d->fd, d->kf_scratch, n);

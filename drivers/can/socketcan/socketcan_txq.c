@@ -96,7 +96,8 @@ enum sc_txq_echo_result sc_txq_echo(struct sc_txq *q, const struct socketcan_hos
 	return SC_TXQ_ECHO_MATCHED;
 }
 
-uint64_t sc_txq_next_expiry(const struct sc_txq *q)
+/* When the oldest entry expires if no echo comes; UINT64_MAX if the queue is empty. */
+static uint64_t sc_txq_next_expiry(const struct sc_txq *q)
 {
 	uint64_t since;
 

@@ -79,9 +79,6 @@ enum sc_txq_echo_result sc_txq_echo(struct sc_txq *q, const struct socketcan_hos
  */
 int sc_txq_expire(struct sc_txq *q, uint64_t now_ns, struct sc_txq_entry *out);
 
-/* When the oldest entry expires if no echo comes; UINT64_MAX if the queue is empty. */
-uint64_t sc_txq_next_expiry(const struct sc_txq *q);
-
 /* Removes every entry into @p out, oldest first; returns how many. */
 int sc_txq_take_all(struct sc_txq *q, struct sc_txq_entry *out);
 
