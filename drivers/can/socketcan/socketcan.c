@@ -9,8 +9,21 @@
  *
  * This file sees only RTOS headers; Linux is behind socketcan_host.h (both define struct
  * can_frame). One receive thread per controller blocks in recvmsg(); it delivers frames,
- * turns the echo of our own frames into TX completions (first in, first out, as the kernel
- * keeps the order) and error frames into enum can_state.
+ * turns the echo of our own frames into TX completions and error frames into enum can_state.
+ *
+ * The kernel filters: the socket's CAN_RAW_FILTER is the union of the receive filters and of
+ * the identifiers we send (so that their echoes come back, whatever the receive filters), and
+ * is rewritten whenever either changes. Frames nobody asked for never reach the socket, so a
+ * flood on another identifier cannot fill its receive buffer.
+ *
+ * TX completion: a frame written to the socket waits in the in-flight queue (socketcan_txq.h)
+ * for its echo. An echo that never comes (the socket's buffer overflowed in a flood, or the
+ * interface does not get the frame out) must not hold the entry for ever: the entry is released
+ * with -ETIMEDOUT when a later frame's echo shows that its own was lost, or when no echo has
+ * come for CONFIG_CAN_SOCKETCAN_TX_ECHO_TIMEOUT_MS. The receive thread judges that bound by
+ * the kernel's receive stamps of what it reads (an echo already queued is never called late
+ * because the thread was slow) and, when the socket is empty, by the clock; SO_RCVTIMEO wakes
+ * it a quarter of the bound after the last frame.
  *
  * Stopped means deaf: the socket stays open (its queue keeps the echoes that complete frames
  * already handed to the kernel), so it also collects the frames that arrive while the
@@ -50,22 +63,42 @@
 #include "posix_board_if.h"
 #include "posix_native_task.h"
 #include "socketcan_host.h"
+#include "socketcan_txq.h"
 
 LOG_MODULE_REGISTER(can_socketcan, CONFIG_CAN_LOG_LEVEL);
 
-#define SC_NUM_CTRL    CONFIG_CAN_SOCKETCAN_NUM_CONTROLLERS
-#define SC_MAX_FILTERS CONFIG_CAN_SOCKETCAN_MAX_FILTERS
-#define SC_TXQ_SIZE    CONFIG_CAN_SOCKETCAN_TX_QUEUE_SIZE
-#define SC_IFNAMSIZ    16
+#define SC_NUM_CTRL        CONFIG_CAN_SOCKETCAN_NUM_CONTROLLERS
+#define SC_MAX_FILTERS     CONFIG_CAN_SOCKETCAN_MAX_FILTERS
+#define SC_TXQ_SIZE        CONFIG_CAN_SOCKETCAN_TX_QUEUE_SIZE
+#define SC_TX_IDS          CONFIG_CAN_SOCKETCAN_TX_ID_FILTERS
+#define SC_ECHO_TIMEOUT_NS ((uint64_t)CONFIG_CAN_SOCKETCAN_TX_ECHO_TIMEOUT_MS * 1000000ULL)
+/* How long the receive thread waits for a frame before it looks at the clock. */
+#define SC_RECV_TIMEOUT_MS MAX(1U, CONFIG_CAN_SOCKETCAN_TX_ECHO_TIMEOUT_MS / 4U)
+#define SC_IFNAMSIZ        16
 /* The kernel's interface decides the bit rate; these bound what can_set_bitrate() accepts. */
-#define SC_MIN_BITRATE 10000U
-#define SC_MAX_BITRATE 1000000U
+#define SC_MIN_BITRATE     10000U
+#define SC_MAX_BITRATE     1000000U
 
 BUILD_ASSERT(SC_NUM_CTRL <= 8, "the driver defines up to 8 controllers");
+/* Every frame in flight has its identifier in the kernel filter (sc_tx_id_use_locked()). */
+BUILD_ASSERT(
+	SC_TX_IDS >= SC_TXQ_SIZE,
+	"CONFIG_CAN_SOCKETCAN_TX_ID_FILTERS must be at least CONFIG_CAN_SOCKETCAN_TX_QUEUE_SIZE");
+BUILD_ASSERT(SC_MAX_FILTERS + SC_TX_IDS <= SOCKETCAN_HOST_MAX_FILTERS,
+	     "the kernel takes at most 512 filter entries per socket");
 
-struct sc_tx {
-	can_tx_callback_t cb;
-	void *user_data;
+/* A receive filter as the kernel sees it. */
+struct sc_kfilter {
+	struct socketcan_host_filter f;
+	bool used;
+};
+
+/* An identifier we sent, kept in the kernel filter so that its echo comes back. */
+struct sc_tx_id {
+	uint32_t id;
+	uint8_t flags; /* SOCKETCAN_HOST_F_IDE */
+	bool used;
+	uint32_t last_used; /* sc_data.tx_id_clock at its last send */
 };
 
 struct sc_config {
@@ -83,10 +116,14 @@ struct sc_data {
 	enum can_state state;
 	struct can_bus_err_cnt err_cnt;
 	uint32_t bitrate;
-	struct sc_tx inflight[SC_TXQ_SIZE]; /* FIFO of frames awaiting their echo */
-	uint16_t head;
-	uint16_t count;
-	uint32_t stale_echoes; /* echoes still due for frames aborted by bus-off */
+	struct sc_txq txq; /* frames awaiting their echo */
+	struct sc_txq_entry txq_entries[SC_TXQ_SIZE];
+	/* the kernel filter: a mirror of the receive filters and the identifiers we send */
+	struct sc_kfilter rx_kf[SC_MAX_FILTERS];
+	struct sc_tx_id tx_ids[SC_TX_IDS];
+	uint32_t tx_id_clock; /* counts sends, for tx_ids[].last_used */
+	struct socketcan_host_filter kf_scratch[SC_MAX_FILTERS + SC_TX_IDS];
+	struct can_socketcan_stats stats;
 	/* receive gate: frames stamped before the last can_start() are not delivered */
 	uint64_t start_real_ns;  /* CLOCK_REALTIME at the last can_start() */
 	int64_t start_offset_ns; /* CLOCK_REALTIME - CLOCK_MONOTONIC then (to see clock steps) */
@@ -243,46 +280,46 @@ static inline struct sc_data *sc_data(const struct device *dev)
 	return (struct sc_data *)dev->data;
 }
 
+/*
+ * CLOCK_MONOTONIC minus the kernel's uptime, in ns: on native_posix the uptime is the host's
+ * monotonic clock since boot, so the difference is a constant. Measured once, as the middle
+ * of the tightest of a few bracketing reads: a thread preempted between two clock reads
+ * would otherwise shift every stamp by the preemption, differently for each frame.
+ */
+static uint64_t sc_uptime_offset_ns;
+
+static void sc_measure_uptime_offset(void)
+{
+	uint64_t best = UINT64_MAX;
+
+	for (int i = 0; i < 5; i++) {
+		uint64_t before = socketcan_host_mono_ns();
+		uint64_t up_ns = k_ticks_to_ns_floor64((uint64_t)k_uptime_ticks());
+		uint64_t after = socketcan_host_mono_ns();
+
+		if (after - before < best) {
+			best = after - before;
+			sc_uptime_offset_ns = before + (after - before) / 2U - up_ns;
+		}
+	}
+}
+
 /* Microseconds on the kernel's uptime clock at which the host received a frame. */
 static uint64_t sc_rx_time_us(uint64_t rx_mono_ns)
 {
-	uint64_t up_ns = k_ticks_to_ns_floor64((uint64_t)k_uptime_ticks());
-	uint64_t host_now = socketcan_host_mono_ns();
-	uint64_t age = (rx_mono_ns != 0U && host_now > rx_mono_ns) ? host_now - rx_mono_ns : 0U;
-
-	return ((age < up_ns) ? up_ns - age : 0U) / 1000U;
+	return ((rx_mono_ns > sc_uptime_offset_ns) ? rx_mono_ns - sc_uptime_offset_ns : 0U) / 1000U;
 }
 
-/* Takes the oldest in-flight entry; returns false if there is none. Under lock. */
-static bool sc_pop_locked(struct sc_data *d, struct sc_tx *out)
+/* After entries left the in-flight queue: wake can_stop() if it is empty now. Under lock. */
+static void sc_txq_left_locked(struct sc_data *d)
 {
-	if (d->count == 0U) {
-		return false;
-	}
-	*out = d->inflight[d->head];
-	d->head = (uint16_t)((d->head + 1U) % SC_TXQ_SIZE);
-	d->count--;
-	if (d->count == 0U) {
+	if (sc_txq_count(&d->txq) == 0U) {
 		k_sem_give(&d->tx_idle);
 	}
-
-	return true;
 }
 
-/* Aborts every in-flight frame (bus-off): their echoes will be ignored. Under lock. */
-static int sc_abort_locked(struct sc_data *d, struct sc_tx out[SC_TXQ_SIZE])
-{
-	int n = 0;
-
-	while (sc_pop_locked(d, &out[n])) {
-		d->stale_echoes++;
-		n++;
-	}
-
-	return n;
-}
-
-static void sc_run_aborted(struct sc_data *d, const struct sc_tx *t, int n, int error)
+/* Frees the slots of entries that left the queue and runs their callbacks. Without lock. */
+static void sc_complete(struct sc_data *d, const struct sc_txq_entry *t, int n, int error)
 {
 	for (int i = 0; i < n; i++) {
 		k_sem_give(&d->tx_slots);
@@ -290,6 +327,126 @@ static void sc_run_aborted(struct sc_data *d, const struct sc_tx *t, int n, int 
 			t[i].cb(d->dev, error, t[i].user_data);
 		}
 	}
+}
+
+/*
+ * Releases the entries whose echo has not come for the bound, as of @p now_ns (a receive
+ * stamp, or the clock when the socket is empty).
+ */
+static void sc_expire(struct sc_data *d, uint64_t now_ns)
+{
+	struct sc_txq_entry expired[SC_TXQ_SIZE];
+	int n;
+
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
+	n = sc_txq_expire(&d->txq, now_ns, expired);
+	d->stats.tx_echo_timeouts += (uint32_t)n;
+	sc_txq_left_locked(d);
+	(void)k_mutex_unlock(&d->lock);
+
+	if (n > 0) {
+		LOG_WRN("%s (%s): %d frames without echo for %u ms, released", d->dev->name,
+			d->ifname, n, CONFIG_CAN_SOCKETCAN_TX_ECHO_TIMEOUT_MS);
+		sc_complete(d, expired, n, -ETIMEDOUT);
+	}
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The kernel filter                                                                          */
+
+/* Writes the receive filters and the sent identifiers into the socket's filter. Under lock. */
+static int sc_program_filters_locked(struct sc_data *d)
+{
+	int n = 0;
+	int rc;
+
+	for (int i = 0; i < SC_MAX_FILTERS; i++) {
+		if (d->rx_kf[i].used) {
+			d->kf_scratch[n] = d->rx_kf[i].f;
+			n++;
+		}
+	}
+	for (int i = 0; i < SC_TX_IDS; i++) {
+		if (d->tx_ids[i].used) {
+			d->kf_scratch[n] = (struct socketcan_host_filter){
+				.id = d->tx_ids[i].id,
+				.mask = UINT32_MAX,
+				.flags = d->tx_ids[i].flags,
+			};
+			n++;
+		}
+	}
+	rc = socketcan_host_set_filters(d->fd, d->kf_scratch, n);
+	if (rc == 0) {
+		d->stats.kernel_filters = (uint16_t)n;
+	} else {
+		LOG_ERR("%s (%s): cannot set the kernel filter (%d entries): %d", d->dev->name,
+			d->ifname, n, rc);
+	}
+
+	return rc;
+}
+
+/*
+ * Makes sure the kernel filter lets the echo of a frame with this identifier through: an
+ * identifier already there is marked used now; a new one takes a free entry or that of the
+ * identifier sent longest ago. That one has no frame in flight: the in-flight frames are the
+ * last SC_TXQ_SIZE <= SC_TX_IDS written, and their identifiers are the most recently used.
+ * Under lock, in the same critical section as the write.
+ */
+static int sc_tx_id_use_locked(struct sc_data *d, const struct socketcan_host_frame *hf)
+{
+	uint8_t flags = hf->flags & SOCKETCAN_HOST_F_IDE;
+	struct sc_tx_id old;
+	int victim = 0;
+	int rc;
+
+	d->tx_id_clock++;
+	for (int i = 0; i < SC_TX_IDS; i++) {
+		struct sc_tx_id *t = &d->tx_ids[i];
+
+		if (t->used && t->id == hf->id && t->flags == flags) {
+			t->last_used = d->tx_id_clock;
+			return 0;
+		}
+		if (!t->used) {
+			victim = i;
+		} else if (d->tx_ids[victim].used &&
+			   (uint32_t)(d->tx_id_clock - t->last_used) >
+				   (uint32_t)(d->tx_id_clock - d->tx_ids[victim].last_used)) {
+			victim = i;
+		} else {
+			/* a free entry, or one used more recently than the candidate: keep it */
+		}
+	}
+	old = d->tx_ids[victim];
+	d->tx_ids[victim] = (struct sc_tx_id){
+		.id = hf->id,
+		.flags = flags,
+		.used = true,
+		.last_used = d->tx_id_clock,
+	};
+	rc = sc_program_filters_locked(d);
+	if (rc != 0) {
+		d->tx_ids[victim] = old;
+	}
+
+	return rc;
+}
+
+/* Mirrors receive filter @p filter_id (NULL: removed) into the kernel filter. Under lock. */
+static int sc_rx_kf_set_locked(struct sc_data *d, int filter_id, const struct can_filter *filter)
+{
+	struct sc_kfilter *k = &d->rx_kf[filter_id];
+
+	k->used = filter != NULL;
+	if (filter != NULL) {
+		k->f.id = filter->id;
+		k->f.mask = filter->mask;
+		k->f.flags = ((filter->flags & CAN_FILTER_IDE) != 0U) ? SOCKETCAN_HOST_F_IDE : 0U;
+	}
+
+	return sc_program_filters_locked(d);
 }
 
 /* A wall-clock step backwards of more than this since can_start() makes the stamps useless. */
@@ -360,33 +517,40 @@ static void sc_deliver(struct sc_data *d, const struct can_frame *frame, uint64_
 	(void)k_mutex_unlock(&d->rx_lock);
 }
 
-static void sc_on_echo(struct sc_data *d, const struct can_frame *frame, uint64_t rx_real_ns)
+static void sc_on_echo(struct sc_data *d, const struct socketcan_host_frame *hf,
+		       const struct can_frame *frame, const struct socketcan_host_rx_info *info)
 {
-	struct sc_tx tx;
-	bool have;
+	struct sc_txq_entry done;
+	struct sc_txq_entry lost[SC_TXQ_SIZE];
+	int n_lost = 0;
+	enum sc_txq_echo_result found;
 	bool loopback;
 
-	/* The echo completes the oldest frame in flight whenever it comes, also while stopped. */
+	/* The echo completes its frame whenever it comes, also while stopped. */
 	(void)k_mutex_lock(&d->lock, K_FOREVER);
-	if (d->stale_echoes > 0U) {
-		d->stale_echoes--;
-		have = false;
+	found = sc_txq_echo(&d->txq, hf, info->mono_ns, &done, lost, &n_lost);
+	if (found == SC_TXQ_ECHO_MATCHED) {
+		d->stats.tx_confirmed++;
+		d->stats.tx_echoes_lost += (uint32_t)n_lost;
 	} else {
-		have = sc_pop_locked(d, &tx);
+		d->stats.tx_late_echoes++;
 	}
+	sc_txq_left_locked(d);
 	loopback = (d->common.mode & CAN_MODE_LOOPBACK) != 0U;
 	(void)k_mutex_unlock(&d->lock);
 
 	k_sem_give(&d->echo_seen);
 	if (loopback) {
 		/* the mode only changes while stopped; sc_deliver() checks started */
-		sc_deliver(d, frame, rx_real_ns);
+		sc_deliver(d, frame, info->real_ns);
 	}
-	if (have) {
-		k_sem_give(&d->tx_slots);
-		if (tx.cb != NULL) {
-			tx.cb(d->dev, 0, tx.user_data);
-		}
+	if (n_lost > 0) {
+		LOG_WRN("%s (%s): echoes of %d frames lost (receive buffer overflow?), released",
+			d->dev->name, d->ifname, n_lost);
+		sc_complete(d, lost, n_lost, -ETIMEDOUT);
+	}
+	if (found == SC_TXQ_ECHO_MATCHED) {
+		sc_complete(d, &done, 1, 0);
 	}
 }
 
@@ -394,7 +558,7 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 			      uint64_t rx_real_ns)
 {
 	struct socketcan_host_error err;
-	struct sc_tx aborted[SC_TXQ_SIZE];
+	struct sc_txq_entry aborted[SC_TXQ_SIZE];
 	int n_aborted = 0;
 	enum can_state state;
 	struct can_bus_err_cnt cnt;
@@ -445,7 +609,9 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 		cb = d->common.state_change_cb;
 		cb_data = d->common.state_change_cb_user_data;
 		if (state == CAN_STATE_BUS_OFF) {
-			n_aborted = sc_abort_locked(d, aborted);
+			/* their echoes, if they still come, find no entry (late echoes) */
+			n_aborted = sc_txq_take_all(&d->txq, aborted);
+			sc_txq_left_locked(d);
 		}
 	}
 	(void)k_mutex_unlock(&d->lock);
@@ -454,27 +620,64 @@ static void sc_on_error_frame(struct sc_data *d, const struct socketcan_host_fra
 		LOG_INF("%s (%s): state %d, tx %u rx %u", d->dev->name, d->ifname, (int)state,
 			cnt.tx_err_cnt, cnt.rx_err_cnt);
 	}
-	sc_run_aborted(d, aborted, n_aborted, -ENETUNREACH);
+	sc_complete(d, aborted, n_aborted, -ENETUNREACH);
 	if (cb != NULL) {
 		cb(d->dev, state, cnt, cb_data);
 	}
 	(void)k_mutex_unlock(&d->rx_lock);
 }
 
+/* Socket statistics of a frame read. */
+static void sc_count_rx(struct sc_data *d, const struct socketcan_host_frame *hf,
+			const struct socketcan_host_rx_info *info)
+{
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
+	/* the kernel's count only grows; a frame queued before the last drop carries less */
+	d->stats.rx_overflows = MAX(d->stats.rx_overflows, info->drops);
+	if (!info->own && (hf->flags & SOCKETCAN_HOST_F_ERR) == 0U) {
+		d->stats.rx_frames++;
+	}
+	(void)k_mutex_unlock(&d->lock);
+}
+
+static void sc_on_frame(struct sc_data *d, const struct socketcan_host_frame *hf,
+			const struct socketcan_host_rx_info *info)
+{
+	struct can_frame frame;
+
+	(void)memset(&frame, 0, sizeof(frame));
+	frame.id = hf->id;
+	frame.dlc = hf->dlc;
+	frame.flags = (uint8_t)(((hf->flags & SOCKETCAN_HOST_F_IDE) != 0U ? CAN_FRAME_IDE : 0U) |
+				((hf->flags & SOCKETCAN_HOST_F_RTR) != 0U ? CAN_FRAME_RTR : 0U));
+	(void)memcpy(frame.data, hf->data, sizeof(frame.data));
+#if defined(CONFIG_CAN_RX_TIMESTAMP)
+	frame.timestamp = (uint16_t)sc_rx_time_us(info->mono_ns);
+#endif
+
+	if (info->own) {
+		sc_on_echo(d, hf, &frame, info);
+	} else {
+		sc_deliver(d, &frame, info->real_ns);
+	}
+}
+
 static void sc_rx_thread(void *p1, void *p2, void *p3)
 {
 	struct sc_data *d = p1;
 	struct socketcan_host_frame hf;
-	struct can_frame frame;
-	uint64_t rx_real_ns;
-	uint64_t rx_ns;
-	bool own;
+	struct socketcan_host_rx_info info;
 	int last_err = 0;
 
 	for (;;) {
-		int rc = socketcan_host_recv(d->fd, &hf, &rx_real_ns, &rx_ns, &own);
+		int rc = socketcan_host_recv(d->fd, &hf, &info);
 
 		if (rc == -EINTR) {
+			continue;
+		}
+		if (rc == -EAGAIN) {
+			/* the socket is empty: every echo that came is read, judge by the clock */
+			sc_expire(d, socketcan_host_mono_ns());
 			continue;
 		}
 		if (rc < 0) {
@@ -492,28 +695,18 @@ static void sc_rx_thread(void *p1, void *p2, void *p3)
 			continue;
 		}
 		last_err = 0;
+		if (info.mono_ns == 0U) {
+			info.mono_ns = socketcan_host_mono_ns(); /* no stamp: it came by now */
+		}
+		sc_count_rx(d, &hf, &info);
 
 		if ((hf.flags & SOCKETCAN_HOST_F_ERR) != 0U) {
-			sc_on_error_frame(d, &hf, rx_real_ns);
-			continue;
-		}
-
-		(void)memset(&frame, 0, sizeof(frame));
-		frame.id = hf.id;
-		frame.dlc = hf.dlc;
-		frame.flags =
-			(uint8_t)(((hf.flags & SOCKETCAN_HOST_F_IDE) != 0U ? CAN_FRAME_IDE : 0U) |
-				  ((hf.flags & SOCKETCAN_HOST_F_RTR) != 0U ? CAN_FRAME_RTR : 0U));
-		(void)memcpy(frame.data, hf.data, sizeof(frame.data));
-#if defined(CONFIG_CAN_RX_TIMESTAMP)
-		frame.timestamp = (uint16_t)sc_rx_time_us(rx_ns);
-#endif
-
-		if (own) {
-			sc_on_echo(d, &frame, rx_real_ns);
+			sc_on_error_frame(d, &hf, info.real_ns);
 		} else {
-			sc_deliver(d, &frame, rx_real_ns);
+			sc_on_frame(d, &hf, &info);
 		}
+		/* everything before this frame has been read: judge the bound at its stamp */
+		sc_expire(d, info.mono_ns);
 	}
 }
 
@@ -585,7 +778,7 @@ static int sc_stop(const struct device *dev)
 	}
 	for (;;) {
 		(void)k_mutex_lock(&d->lock, K_FOREVER);
-		in_flight = d->count;
+		in_flight = sc_txq_count(&d->txq);
 		(void)k_mutex_unlock(&d->lock);
 		if (in_flight == 0U) {
 			break;
@@ -694,15 +887,15 @@ static int sc_send(const struct device *dev, const struct can_frame *frame, k_ti
 		} else if (d->state == CAN_STATE_BUS_OFF) {
 			rc = -ENETUNREACH;
 		} else {
+			rc = sc_tx_id_use_locked(d, &hf);
+		}
+		if (rc == 0) {
 			/* Queued before the write: the echo may come before send() returns. */
-			uint16_t tail = (uint16_t)((d->head + d->count) % SC_TXQ_SIZE);
-
-			d->inflight[tail].cb = callback;
-			d->inflight[tail].user_data = user_data;
-			d->count++;
+			(void)sc_txq_push(&d->txq, &hf, callback, user_data,
+					  socketcan_host_mono_ns());
 			rc = socketcan_host_send(d->fd, &hf);
 			if (rc != 0) {
-				d->count--;
+				sc_txq_drop_newest(&d->txq);
 			}
 		}
 		(void)k_mutex_unlock(&d->lock);
@@ -724,20 +917,56 @@ static int sc_send(const struct device *dev, const struct can_frame *frame, k_ti
 									: sc_map_send_error(d, rc);
 }
 
+/*
+ * The software table decides what each callback gets; the kernel filter mirrors it so that
+ * frames no filter wants do not reach the socket. Both change under rx_lock, so a table slot
+ * and its kernel entry change together.
+ */
 static int sc_add_rx_filter(const struct device *dev, can_rx_callback_t callback, void *user_data,
 			    const struct can_filter *filter)
 {
 	struct sc_data *d = sc_data(dev);
+	int id;
 
-	return can_filter_table_add(d->filters, SC_MAX_FILTERS, &d->rx_lock, callback, user_data,
-				    filter);
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
+	id = can_filter_table_add(d->filters, SC_MAX_FILTERS, &d->rx_lock, callback, user_data,
+				  filter);
+	if (id >= 0 && d->fd >= 0) {
+		int rc;
+
+		(void)k_mutex_lock(&d->lock, K_FOREVER);
+		rc = sc_rx_kf_set_locked(d, id, filter);
+		if (rc != 0) {
+			(void)sc_rx_kf_set_locked(d, id, NULL);
+		}
+		(void)k_mutex_unlock(&d->lock);
+		if (rc != 0) {
+			/* the kernel refused more entries (out of memory): as if out of filters */
+			can_filter_table_remove(d->filters, SC_MAX_FILTERS, &d->rx_lock, id);
+			id = -ENOSPC;
+		}
+	}
+	(void)k_mutex_unlock(&d->rx_lock);
+
+	return id;
 }
 
 static void sc_remove_rx_filter(const struct device *dev, int filter_id)
 {
 	struct sc_data *d = sc_data(dev);
 
+	if (filter_id < 0 || filter_id >= SC_MAX_FILTERS) {
+		return;
+	}
+	(void)k_mutex_lock(&d->rx_lock, K_FOREVER);
 	can_filter_table_remove(d->filters, SC_MAX_FILTERS, &d->rx_lock, filter_id);
+	if (d->fd >= 0) {
+		(void)k_mutex_lock(&d->lock, K_FOREVER);
+		/* on failure the kernel keeps a wider filter: the table still drops the frames */
+		(void)sc_rx_kf_set_locked(d, filter_id, NULL);
+		(void)k_mutex_unlock(&d->lock);
+	}
+	(void)k_mutex_unlock(&d->rx_lock);
 }
 
 static int sc_get_state(const struct device *dev, enum can_state *state,
@@ -794,6 +1023,21 @@ const char *can_socketcan_ifname(const struct device *dev)
 	return sc_is_ours(dev) ? sc_data(dev)->ifname : NULL;
 }
 
+int can_socketcan_get_stats(const struct device *dev, struct can_socketcan_stats *stats)
+{
+	struct sc_data *d;
+
+	if (!sc_is_ours(dev) || stats == NULL) {
+		return -EINVAL;
+	}
+	d = sc_data(dev);
+	(void)k_mutex_lock(&d->lock, K_FOREVER);
+	*stats = d->stats;
+	(void)k_mutex_unlock(&d->lock);
+
+	return 0;
+}
+
 int can_socketcan_inject_state(const struct device *dev, enum can_state state)
 {
 	static const enum socketcan_host_state host_state[] = {
@@ -832,6 +1076,7 @@ static int sc_init(const struct device *dev)
 {
 	const struct sc_config *cfg = dev->config;
 	struct sc_data *d = dev->data;
+	int rc;
 
 	d->dev = dev;
 	d->fd = -1;
@@ -843,6 +1088,10 @@ static int sc_init(const struct device *dev)
 	(void)k_sem_init(&d->tx_slots, SC_TXQ_SIZE, SC_TXQ_SIZE);
 	(void)k_sem_init(&d->echo_seen, 0, 1);
 	(void)k_sem_init(&d->tx_idle, 0, 1);
+	sc_txq_init(&d->txq, d->txq_entries, SC_TXQ_SIZE, SC_ECHO_TIMEOUT_NS);
+	if (sc_uptime_offset_ns == 0U) {
+		sc_measure_uptime_offset(); /* devices initialise one after the other */
+	}
 
 	sc_resolve_ifname(cfg->index, d->ifname);
 	if (d->ifname[0] == '\0') {
@@ -853,10 +1102,18 @@ static int sc_init(const struct device *dev)
 
 	d->fd = socketcan_host_open(d->ifname);
 	if (d->fd < 0) {
-		int rc = d->fd;
-
+		rc = d->fd;
 		LOG_ERR("%s: cannot open CAN interface %s: %s (%d)", dev->name, d->ifname,
 			sc_open_error(rc), rc);
+		d->fd = -1;
+		return rc;
+	}
+	/* wakes the receive thread, which has frames in flight to judge, when the socket is quiet
+	 */
+	rc = socketcan_host_set_recv_timeout(d->fd, SC_RECV_TIMEOUT_MS);
+	if (rc != 0) {
+		LOG_ERR("%s: cannot set the receive timeout on %s: %d", dev->name, d->ifname, rc);
+		socketcan_host_close(d->fd);
 		d->fd = -1;
 		return rc;
 	}

@@ -26,6 +26,7 @@
 #include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <sys/uio.h>
 
 #include "socketcan_host.h"
@@ -63,13 +64,22 @@ int socketcan_host_open(const char *ifname)
 		goto fail;
 	}
 
-	/* The echo of our own frames is the TX confirmation; error frames give the state. */
+	/*
+	 * The echo of our own frames is the TX confirmation; error frames give the state. No data
+	 * frame is wanted before the driver says which (an empty filter list).
+	 */
 	rc = set_opt(fd, SOL_CAN_RAW, CAN_RAW_RECV_OWN_MSGS, &one, sizeof(one));
 	if (rc == 0) {
 		rc = set_opt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask));
 	}
 	if (rc == 0) {
+		rc = set_opt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, NULL, 0);
+	}
+	if (rc == 0) {
 		rc = set_opt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof(one));
+	}
+	if (rc == 0) {
+		rc = set_opt(fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one));
 	}
 	if (rc != 0) {
 		goto fail;
@@ -88,6 +98,38 @@ int socketcan_host_open(const char *ifname)
 fail:
 	(void)close(fd);
 	return rc;
+}
+
+int socketcan_host_set_filters(int fd, const struct socketcan_host_filter *filters, int n)
+{
+	struct can_filter kf[SOCKETCAN_HOST_MAX_FILTERS];
+
+	if (n < 0 || n > SOCKETCAN_HOST_MAX_FILTERS) {
+		return -EINVAL;
+	}
+	for (int i = 0; i < n; i++) {
+		/* CAN_EFF_FLAG in the mask: the frame's type must be the filter's. */
+		if ((filters[i].flags & SOCKETCAN_HOST_F_IDE) != 0U) {
+			kf[i].can_id = (filters[i].id & CAN_EFF_MASK) | CAN_EFF_FLAG;
+			kf[i].can_mask = (filters[i].mask & CAN_EFF_MASK) | CAN_EFF_FLAG;
+		} else {
+			kf[i].can_id = filters[i].id & CAN_SFF_MASK;
+			kf[i].can_mask = (filters[i].mask & CAN_SFF_MASK) | CAN_EFF_FLAG;
+		}
+	}
+
+	return set_opt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, (n > 0) ? kf : NULL,
+		       (socklen_t)((size_t)n * sizeof(kf[0])));
+}
+
+int socketcan_host_set_recv_timeout(int fd, uint32_t ms)
+{
+	const struct timeval tv = {
+		.tv_sec = (time_t)(ms / 1000U),
+		.tv_usec = (suseconds_t)((ms % 1000U) * 1000U),
+	};
+
+	return set_opt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
 }
 
 void socketcan_host_close(int fd)
@@ -178,13 +220,13 @@ static uint64_t realtime_to_mono_ns(uint64_t rt_ns)
 	return now_mono - (uint64_t)age;
 }
 
-int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_real_ns,
-			uint64_t *rx_mono_ns, bool *own)
+int socketcan_host_recv(int fd, struct socketcan_host_frame *frame,
+			struct socketcan_host_rx_info *info)
 {
 	struct can_frame cf;
 	struct iovec iov = {.iov_base = &cf, .iov_len = sizeof(cf)};
 	union {
-		char buf[CMSG_SPACE(sizeof(struct timespec))];
+		char buf[CMSG_SPACE(sizeof(struct timespec)) + CMSG_SPACE(sizeof(uint32_t))];
 		struct cmsghdr align;
 	} ctrl;
 	struct msghdr msg = {
@@ -196,24 +238,30 @@ int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx
 	ssize_t n = recvmsg(fd, &msg, 0);
 
 	if (n < 0) {
-		return -errno;
+		/* SO_RCVTIMEO ends a wait with EAGAIN (EWOULDBLOCK on some ABIs) */
+		return (errno == EWOULDBLOCK) ? -EAGAIN : -errno;
 	}
 	if (n != (ssize_t)sizeof(cf)) {
 		return -EIO; /* CAN FD frames are not enabled on the socket */
 	}
 
-	*rx_real_ns = 0U;
-	*rx_mono_ns = 0U;
+	info->real_ns = 0U;
+	info->mono_ns = 0U;
+	info->drops = 0U; /* the kernel adds the count only once it is not zero */
 	for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c != NULL; c = CMSG_NXTHDR(&msg, c)) {
 		if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
 			struct timespec ts;
 
 			(void)memcpy(&ts, CMSG_DATA(c), sizeof(ts));
-			*rx_real_ns = (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
-			*rx_mono_ns = realtime_to_mono_ns(*rx_real_ns);
+			info->real_ns = (uint64_t)ts.tv_sec * 1000000000ULL + (uint64_t)ts.tv_nsec;
+			info->mono_ns = realtime_to_mono_ns(info->real_ns);
+		} else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+			(void)memcpy(&info->drops, CMSG_DATA(c), sizeof(info->drops));
+		} else {
+			/* no other ancillary data is enabled */
 		}
 	}
-	*own = (msg.msg_flags & MSG_CONFIRM) != 0;
+	info->own = (msg.msg_flags & MSG_CONFIRM) != 0;
 
 	(void)memset(frame, 0, sizeof(*frame));
 	frame->dlc = cf.len > 8U ? 8U : cf.len;

@@ -38,6 +38,27 @@ enum socketcan_host_state {
 	SOCKETCAN_HOST_STATE_BUS_OFF,
 };
 
+/* Entries one socketcan_host_set_filters() call takes at most (the kernel's limit). */
+#define SOCKETCAN_HOST_MAX_FILTERS 512
+
+/*
+ * One entry of the socket's kernel filter: frames whose identifier equals @p id in the bits set
+ * in @p mask, of the type given by SOCKETCAN_HOST_F_IDE in @p flags (data and remote frames).
+ */
+struct socketcan_host_filter {
+	uint32_t id;
+	uint32_t mask;
+	uint8_t flags;
+};
+
+/* What the kernel says about a received frame besides its content. */
+struct socketcan_host_rx_info {
+	uint64_t real_ns; /* receive time as stamped (CLOCK_REALTIME), 0 if none */
+	uint64_t mono_ns; /* the same instant on CLOCK_MONOTONIC, 0 if none */
+	uint32_t drops;   /* frames the socket dropped so far, its receive buffer being full */
+	bool own;         /* the echo of a frame written through this socket */
+};
+
 struct socketcan_host_error {
 	enum socketcan_host_state state;
 	bool has_counters; /* the frame carried the error counters (CAN_ERR_CNT) */
@@ -46,11 +67,22 @@ struct socketcan_host_error {
 };
 
 /*
- * Open a raw CAN socket bound to @p ifname that receives every frame on the interface, its own
- * frames back (as TX confirmations) and all error frames, with kernel receive timestamps.
+ * Open a raw CAN socket bound to @p ifname that receives all error frames, its own frames back
+ * (as TX confirmations) and, until socketcan_host_set_filters() says otherwise, no other frame;
+ * with kernel receive timestamps and the count of frames dropped on overflow.
  * Returns the socket (>= 0) or -errno (-ENODEV: no such interface; -EAFNOSUPPORT: no AF_CAN).
  */
 int socketcan_host_open(const char *ifname);
+
+/*
+ * Replace the socket's kernel filter (CAN_RAW_FILTER) with @p n entries (0: no frame but
+ * error frames). The kernel drops every other frame before it reaches the socket's buffer; a
+ * frame that matches several entries is received once.
+ */
+int socketcan_host_set_filters(int fd, const struct socketcan_host_filter *filters, int n);
+
+/* Make socketcan_host_recv() return -EAGAIN after @p ms without a frame (SO_RCVTIMEO). */
+int socketcan_host_set_recv_timeout(int fd, uint32_t ms);
 
 void socketcan_host_close(int fd);
 
@@ -64,13 +96,13 @@ int socketcan_host_is_up(const char *ifname);
 int socketcan_host_send(int fd, const struct socketcan_host_frame *frame);
 
 /*
- * Block until a frame arrives. @p rx_real_ns gets the kernel's receive time as the kernel
- * stamped it (CLOCK_REALTIME, comparable with socketcan_host_real_ns()), @p rx_mono_ns the
- * same instant mapped onto CLOCK_MONOTONIC (both 0 if the kernel gave none), @p own tells
- * whether it is the echo of a frame sent through this socket. -EINTR if interrupted by a signal.
+ * Block until a frame arrives. @p info gets the kernel's receive time as the kernel stamped it
+ * (CLOCK_REALTIME, comparable with socketcan_host_real_ns()), the same instant mapped onto
+ * CLOCK_MONOTONIC, the socket's drop count and whether the frame is the echo of one written
+ * through this socket. -EINTR if interrupted by a signal, -EAGAIN after the receive timeout.
  */
-int socketcan_host_recv(int fd, struct socketcan_host_frame *frame, uint64_t *rx_real_ns,
-			uint64_t *rx_mono_ns, bool *own);
+int socketcan_host_recv(int fd, struct socketcan_host_frame *frame,
+			struct socketcan_host_rx_info *info);
 
 /* Decode an error frame (flags has SOCKETCAN_HOST_F_ERR). */
 void socketcan_host_decode_error(const struct socketcan_host_frame *frame,

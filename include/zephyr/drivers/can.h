@@ -164,7 +164,8 @@ struct can_bus_err_cnt {
  *
  * @param dev The controller.
  * @param error 0 when the frame was sent; -ENETDOWN if the controller was stopped first;
- *        -ENETUNREACH if it went bus-off first; -EIO on another transmit error.
+ *        -ENETUNREACH if it went bus-off first; -ETIMEDOUT if the driver got no
+ *        confirmation in time (SocketCAN: no echo); -EIO on another transmit error.
  * @param user_data As passed to can_send().
  */
 typedef void (*can_tx_callback_t)(const struct device *dev, int error, void *user_data);

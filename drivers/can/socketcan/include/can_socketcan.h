@@ -5,7 +5,7 @@
 
 /**
  * @file
- * @brief Test helpers of the SocketCAN driver (not Zephyr API).
+ * @brief Statistics and test helpers of the SocketCAN driver (not Zephyr API).
  */
 
 #ifndef SAFELINE_DRIVERS_CAN_SOCKETCAN_H_
@@ -24,6 +24,36 @@ extern "C" {
  * @return Interface name, or NULL if @p dev is not a SocketCAN controller.
  */
 const char *can_socketcan_ifname(const struct device *dev);
+
+/** @brief What a SocketCAN controller's socket has seen since it was opened. */
+struct can_socketcan_stats {
+	/** Data and remote frames read from the socket, own echoes not counted: what the
+	 *  kernel filter let through. */
+	uint32_t rx_frames;
+	/** Frames the kernel dropped because the socket's receive buffer was full
+	 *  (SO_RXQ_OVFL), as of the last frame read. */
+	uint32_t rx_overflows;
+	/** Frames confirmed by their echo (TX callback 0). */
+	uint32_t tx_confirmed;
+	/** Frames released because no echo came for CONFIG_CAN_SOCKETCAN_TX_ECHO_TIMEOUT_MS
+	 *  (TX callback -ETIMEDOUT). */
+	uint32_t tx_echo_timeouts;
+	/** Frames released because a later frame's echo came first, so theirs was lost
+	 *  (TX callback -ETIMEDOUT). */
+	uint32_t tx_echoes_lost;
+	/** Echoes that matched no frame in flight (of frames released before). */
+	uint32_t tx_late_echoes;
+	/** Entries in the socket's kernel filter now: receive filters plus sent identifiers. */
+	uint16_t kernel_filters;
+};
+
+/**
+ * @brief Read a SocketCAN controller's socket statistics.
+ *
+ * @retval 0 Copied into @p stats.
+ * @retval -EINVAL @p dev is not a SocketCAN controller or @p stats is NULL.
+ */
+int can_socketcan_get_stats(const struct device *dev, struct can_socketcan_stats *stats);
 
 /**
  * @brief Write the Linux error frame that announces @p state onto the controller's interface,

@@ -657,6 +657,80 @@ ZTEST(can_api, test_state_changes)
 	expect_frame(&peer_rxq, &f);
 }
 
+#if defined(CONFIG_CAN_SOCKETCAN)
+CAN_MSGQ_DEFINE(dut_all_q, 32);
+
+static struct can_socketcan_stats dut_stats(void)
+{
+	struct can_socketcan_stats st;
+
+	zassert_ok(can_socketcan_get_stats(dut, &st));
+	return st;
+}
+
+/* Peer sends @p n frames of @p id and a sentinel; the dut gets the sentinel. Frames read. */
+static uint32_t frames_read_for(uint32_t id, int n)
+{
+	const struct can_frame f = frame_of(id, 0, 1, (const uint8_t[]){0x3B});
+	uint32_t before = dut_stats().rx_frames;
+
+	for (int i = 0; i < n; i++) {
+		send_ok(peer, &f);
+	}
+	send_sentinel(peer);
+	/* the socket reads in order: once the sentinel is here, so are the frames before it */
+	expect_sentinel(&dut_rxq);
+
+	return dut_stats().rx_frames - before;
+}
+
+ZTEST(can_api, test_the_kernel_filter_keeps_frames_no_filter_wants_out_of_the_socket)
+{
+	int all;
+
+	add_filter_msgq(dut, &dut_rxq, SENTINEL_ID, CAN_STD_ID_MASK, 0);
+	zassert_equal(frames_read_for(0x3B0, 5), 1, "the socket read frames no filter wants");
+
+	/* a catch-all filter gives the whole bus, and once removed the kernel drops it again */
+	all = can_add_rx_filter_msgq(dut, &dut_all_q, &(struct can_filter){.id = 0, .mask = 0});
+	zassert_true(all >= 0);
+	zassert_equal(frames_read_for(0x3B0, 5), 6, "a catch-all filter missed frames");
+	for (int i = 0; i < 6; i++) {
+		struct can_frame got;
+
+		zassert_ok(k_msgq_get(&dut_all_q, &got, WAIT), "not delivered to the catch-all");
+		zassert_equal(got.id, i < 5 ? 0x3B0 : SENTINEL_ID);
+	}
+	can_remove_rx_filter(dut, all);
+	zassert_equal(frames_read_for(0x3B0, 5), 1, "a removed filter still lets frames in");
+}
+
+ZTEST(can_api, test_every_frame_is_confirmed_whatever_the_receive_filters)
+{
+	/* More identifiers than the kernel filter keeps for echoes: the oldest make room. */
+	const int n = CONFIG_CAN_SOCKETCAN_TX_ID_FILTERS + 8;
+	struct can_socketcan_stats before = dut_stats();
+	struct can_socketcan_stats after;
+
+	add_filter_msgq(dut, &dut_rxq, SENTINEL_ID, CAN_STD_ID_MASK, 0);
+	for (int round = 0; round < 2; round++) {
+		for (int i = 0; i < n; i++) {
+			const struct can_frame f =
+				frame_of(0x200 + (uint32_t)i, 0, 1, (const uint8_t[]){(uint8_t)i});
+
+			send_ok(dut, &f); /* 0: its echo came, no receive filter wants it */
+		}
+	}
+	after = dut_stats();
+	zassert_equal(after.tx_confirmed - before.tx_confirmed, 2U * (uint32_t)n);
+	zassert_equal(after.tx_echo_timeouts, before.tx_echo_timeouts);
+	zassert_equal(after.tx_echoes_lost, before.tx_echoes_lost);
+	/* the sentinel filters of both (@0: one socket each) plus the sent identifiers kept */
+	zassert_equal(after.kernel_filters, 1 + CONFIG_CAN_SOCKETCAN_TX_ID_FILTERS, "%u entries",
+		      after.kernel_filters);
+}
+#endif
+
 ZTEST(can_api, test_dlc_conversion)
 {
 	/* ISO 11898-1:2015 DLC table */

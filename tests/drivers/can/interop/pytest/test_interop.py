@@ -8,19 +8,17 @@ Run by the test runner inside the vcan VM (fixture vcan): SAFELINE_IMAGE is the 
 """
 
 import os
-import queue
 import re
-import shutil
-import subprocess
-import threading
+import sys
 import time
 
-import pytest
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "lib"))
+
+from socketcan_peer import WAIT_S, Lines, cansend, iface, image  # noqa: E402,F401
 
 GO = "7FD#"
 QUIT = "7FF#"
 PROBE_ID = 0x7FE
-WAIT_S = 30  # syscalls are slow inside UML: generous, but a hang still fails
 
 
 def parse_cansend(text):
@@ -50,74 +48,6 @@ def parse_candump(line):
     if rest == "remote request":
         return (len(ident) == 8, int(ident, 16), True, dlc, b"")
     return (len(ident) == 8, int(ident, 16), False, dlc, bytes.fromhex(rest.replace(" ", "")))
-
-
-class Lines:
-    """A process whose stdout lines are read by a thread, to wait on with a deadline."""
-
-    def __init__(self, argv):
-        self.proc = subprocess.Popen(
-            argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
-        )
-        self.q = queue.Queue()
-        self.seen = []
-        threading.Thread(target=self._pump, daemon=True).start()
-
-    def _pump(self):
-        for line in self.proc.stdout:
-            self.q.put(line.rstrip("\n"))
-        self.q.put(None)
-
-    def next(self, timeout=WAIT_S):
-        line = self.q.get(timeout=timeout)
-        if line is not None:
-            self.seen.append(line)
-        return line
-
-    def wait_for(self, pred, timeout=WAIT_S):
-        end = time.monotonic() + timeout
-        while True:
-            left = end - time.monotonic()
-            if left <= 0:
-                raise AssertionError(f"timed out; output so far: {self.seen}")
-            try:
-                line = self.next(left)
-            except queue.Empty:
-                continue
-            if line is None:
-                raise AssertionError(f"process ended; output: {self.seen}")
-            if pred(line):
-                return line
-
-    def stop(self):
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-
-
-@pytest.fixture(scope="module")
-def iface():
-    ifaces = os.environ.get("SAFELINE_CAN_IFACES", "")
-    if not ifaces:
-        pytest.skip("needs the vcan fixture (SAFELINE_CAN_IFACES): run via scripts/twister")
-    for tool in ("candump", "cansend"):
-        assert shutil.which(tool), f"{tool} missing (can-utils: scripts/setup)"
-    return ifaces.split(",")[0]
-
-
-@pytest.fixture(scope="module")
-def image():
-    path = os.environ.get("SAFELINE_IMAGE")
-    assert path and os.path.exists(path), "SAFELINE_IMAGE must name the built zephyr.exe"
-    return path
-
-
-def cansend(iface, frame):
-    subprocess.run(["cansend", iface, frame], check=True, timeout=WAIT_S)
 
 
 def start_image(image, iface, frames=()):
