@@ -53,11 +53,10 @@ extern "C" {
 #else
 #define CO_OD_HOOKS_MAX 32
 #endif
-/* The hook-coverage cache: on unless a Kconfig build turned CONFIG_CANOPEN_OD_COVER off. */
-#if defined(CONFIG_CANOPEN_OD_COVER) || !defined(CONFIG_CANOPEN_OD)
-#define CO_OD_COVER 1
+#ifdef CONFIG_CANOPEN_OD_HOOK_LINKS
+#define CO_OD_HOOK_LINKS CONFIG_CANOPEN_OD_HOOK_LINKS
 #else
-#define CO_OD_COVER 0
+#define CO_OD_HOOK_LINKS 64
 #endif
 /* Object providers: on unless a Kconfig build turned CONFIG_CANOPEN_OD_PROVIDERS off. */
 #if defined(CONFIG_CANOPEN_OD_PROVIDERS) || !defined(CONFIG_CANOPEN_OD)
@@ -203,8 +202,10 @@ struct co_od_def {
 	const void *rom;          /**< values of const objects */
 	const char *names;        /**< ParameterName pool, NULL if not built in */
 	const char *eds_header;   /**< FileInfo/DeviceInfo/... text, NULL if not built */
-	uint32_t ram_size;        /**< sizeof the RAM block */
+	uint32_t ram_size;        /**< bytes of values at the start of the RAM block */
 	uint32_t comm_end;        /**< RAM [0, comm_end) holds 1000h-1FFFh values */
+	/** offset in the RAM block of the node's hook heads, one uint16_t per entry */
+	uint32_t hook_heads;
 	uint16_t n_entries;
 	uint16_t n_nodeid;
 	uint32_t n_subs;
@@ -234,7 +235,12 @@ struct co_od_info {
 	uint8_t flags;                     /**< CO_OD_F_* */
 	uint8_t objcode;                   /**< enum co_od_objcode */
 	uint8_t group;                     /**< enum co_od_group */
+	/** position of the object's entry in co_od_def.entries; CO_OD_NO_ENTRY if none */
+	uint16_t entry;
 };
+
+/** @brief co_od_info.entry of a provider's object outside the dictionary. */
+#define CO_OD_NO_ENTRY 0xFFFFU
 
 /**
  * @brief Validate return value: the write is a command that the hook carried out.
@@ -312,27 +318,20 @@ struct co_od_hook {
 };
 
 /** @cond INTERNAL_HIDDEN */
-/*
- * A hook as the dictionary's table keeps it. A registration's read check, which few hooks
- * have, takes an entry of its own (kind CO_OD_HOOK_ENT_READ_CHECK, notify NULL) right after
- * the entry of its validate and notify callbacks: 20 instead of 24 bytes per entry on a
- * 32-bit target.
- */
-#define CO_OD_HOOK_ENT_PLAIN      0U /* fn.validate (may be NULL) and notify */
-#define CO_OD_HOOK_ENT_READ_CHECK 1U /* fn.read_check only */
-
+/* A registered hook: the caller's struct co_od_hook and its registration number. */
 struct co_od_hook_ent {
-	uint16_t index_first;
-	uint16_t index_last;
-	uint8_t sub_first;
-	uint8_t sub_last;
-	uint8_t kind; /* CO_OD_HOOK_ENT_* */
-	union co_od_hook_fn {
-		co_od_validate_cb validate;
-		co_od_read_check_cb read_check;
-	} fn;
-	co_od_notify_cb notify;
-	void *user_data;
+	struct co_od_hook hook;
+	uint32_t seq; /* registration number: orders the hooks of an object */
+};
+
+/*
+ * One hook of one entry: the hooks of an entry are a list of links in registration order,
+ * headed in the node's RAM block (co_od_def.hook_heads). Links are numbered from 1; 0 ends a
+ * list.
+ */
+struct co_od_hook_link {
+	uint16_t hook; /* position in co_od.hooks */
+	uint16_t next; /* number of the entry's next link, 0: none */
 };
 /** @endcond */
 
@@ -404,23 +403,25 @@ struct co_od {
 	uint8_t node_id;             /**< node-ID used for $NODEID values */
 	/** the owning node's mutex, which accessors require (NULL: a dictionary of its own) */
 	const struct k_mutex *lock;
-	uint16_t n_hooks;
-	uint16_t hook_span; /**< largest index_last - index_first among hooks */
+	/** each entry's first hook link, in the node's RAM block (co_od_def.hook_heads) */
+	uint16_t *hook_heads;
+	uint16_t n_hooks; /**< registered hooks */
+	uint16_t n_links; /**< hook links in use */
 #if CO_OD_PROVIDERS
 	uint8_t n_prov;
 #endif
 	co_od_restore_cb restore;
 	void *restore_user_data;
 	const struct co_od_xfer *scratch_owner;
-	/** sorted by index_first; a hook with a read check takes two entries */
+	/** the registered hooks in registration order */
 	struct co_od_hook_ent hooks[CO_OD_HOOKS_MAX];
-	/** registration number of each hook: (index_first, seq) orders the table */
-	uint32_t hook_seq[CO_OD_HOOKS_MAX];
+	/** links of the entries to the hooks covering them */
+	struct co_od_hook_link links[CO_OD_HOOK_LINKS];
 	uint32_t hook_next_seq; /**< registration number of the next hook */
 	/**
 	 * Bumped by every hook registration and removal: a hook loop that called out re-finds
-	 * its place when it changed, and caches of "which hooks cover this object" (PDO) are
-	 * stale when it differs from the value they were made with.
+	 * its place when it changed, and a PDO resolves its mapping again when it differs from
+	 * the value it resolved it at.
 	 */
 	uint32_t hook_gen;
 #if CO_OD_PROVIDERS
@@ -512,16 +513,18 @@ int co_od_set_restore_cb(struct co_od *od, co_od_restore_cb cb, void *user_data)
  * takes part from the next write on. co_od_hook_unregister() likewise.
  *
  * @retval 0 success
- * @retval -EINVAL bad ranges or both callbacks NULL
- * @retval -ENOSPC the table is full: CONFIG_CANOPEN_OD_HOOKS_MAX entries, of which a hook
- *         takes one, two with a read check
+ * @retval -EINVAL bad ranges or both callbacks (validate, notify) NULL
+ * @retval -ENOSPC CONFIG_CANOPEN_OD_HOOKS_MAX hooks are registered, or the links of the
+ *         dictionary's entries to their hooks (one per entry a hook covers) would pass
+ *         CONFIG_CANOPEN_OD_HOOK_LINKS; nothing is registered then
  */
 int co_od_hook_register(struct co_od *od, const struct co_od_hook *hook);
 
 /**
  * @brief Register @p n hooks (a service's table of hooks on its objects).
  * @retval 0 success
- * @retval -EINVAL or -ENOSPC as co_od_hook_register(), for the first hook that failed
+ * @retval -EINVAL or -ENOSPC as co_od_hook_register(), for the first hook that failed; none
+ *         of the @p n hooks is registered then
  */
 int co_od_hooks_register(struct co_od *od, const struct co_od_hook *hooks, size_t n);
 
@@ -565,37 +568,36 @@ uint32_t co_od_find(const struct co_od *od, uint16_t index, uint8_t sub, struct 
 /**
  * @brief Fill @p info for a dictionary object from its descriptor, as co_od_find() does.
  *
- * For a caller that keeps the descriptor of an object found once (with the object's index,
- * object code and group) and rebuilds its info when it accesses it, instead of keeping the
- * whole info (the PDO mapping without CONFIG_CANOPEN_PDO_MAP_INFO).
+ * For a caller that keeps the descriptor of an object found once (and its entry's position)
+ * and needs its info again (a PDO mapping entry calling a notify hook).
  *
- * @param od      dictionary of @p desc
- * @param desc    sub-index descriptor of a dictionary object (not a provider's)
- * @param index   its index
- * @param objcode its object code (enum co_od_objcode)
- * @param group   its group (enum co_od_group)
- * @param info    filled
+ * @param od    dictionary of @p desc
+ * @param entry position of the object's entry in co_od_def.entries
+ * @param desc  sub-index descriptor of a dictionary object (not a provider's)
+ * @param info  filled
  */
-void co_od_info_fill(const struct co_od *od, const struct co_od_sub *desc, uint16_t index,
-		     uint8_t objcode, uint8_t group, struct co_od_info *info);
+void co_od_info_fill(const struct co_od *od, uint16_t entry, const struct co_od_sub *desc,
+		     struct co_od_info *info);
 
 /** @cond INTERNAL_HIDDEN */
-/* co_od_info_fill() inline, for a hot path (the PDO's notify hooks). */
-static inline void co_od_info_fill_inline(const struct co_od *od, const struct co_od_sub *desc,
-					  uint16_t index, uint8_t objcode, uint8_t group,
-					  struct co_od_info *info)
+/* co_od_info_fill() inline, for a hot path (a PDO's notify hooks). */
+static inline void co_od_info_fill_inline(const struct co_od *od, uint16_t entry,
+					  const struct co_od_sub *desc, struct co_od_info *info)
 {
+	const struct co_od_entry *e = &od->def->entries[entry];
+
 	info->desc = desc;
 	info->prov = NULL;
 	info->limit = (desc->flags & CO_OD_F_LIMITS) != 0U ? &od->def->limits[desc->limit] : NULL;
 	info->size = desc->size;
-	info->index = index;
+	info->index = e->index;
 	info->sub = desc->sub;
 	info->dtype = desc->dtype;
 	info->access = desc->access;
 	info->flags = desc->flags;
-	info->objcode = objcode;
-	info->group = group;
+	info->objcode = e->objcode;
+	info->group = e->group;
+	info->entry = entry;
 }
 /** @endcond */
 
@@ -641,120 +643,52 @@ uint32_t co_od_write_info(struct co_od *od, const struct co_od_info *info, const
 			  size_t len, enum co_od_writer writer);
 
 /**
- * @name Cached access for hot paths (PDO)
+ * @name Resolved access for hot paths (PDO, SRDO)
  *
- * A service that keeps a struct co_od_info (a compiled PDO mapping) may keep a
- * struct co_od_cover beside it: which hooks cover the object and whether its value can be
- * moved directly. It is made at first use and made again whenever the hook table changed
- * (co_od.hook_gen), so a write or read through it behaves exactly as co_od_write_info() /
- * co_od_read_info() (same checks, hooks and abort codes) without scanning the hook table.
- *
- * Both accessors are inline for the common case of a PDO or SRDO moving a plain value (a
- * fixed-size RAM value whose C storage is its wire format, mappable in that direction, no
- * limits, no validate or read-check hook, at most one notify hook): a comparison of
- * generations, a copy and, for a covered object, one call of its notify hook. Everything
- * else goes to the functions of od.c.
+ * A service that keeps an object resolved (a compiled PDO mapping) asks once how a whole
+ * value of it moves, co_od_move_of(), and asks again when co_od.hook_gen changed: a plain
+ * copy between the frame and the RAM value (with, for a write, the object's notify hooks
+ * after it, co_od_notify()), or the accessors co_od_write_info() / co_od_read_info(). Either
+ * way the write or read behaves exactly as through the accessors (same checks, hooks and
+ * abort codes).
  * @{
  */
-/** @cond INTERNAL_HIDDEN */
-#define CO_OD_COVER_MADE       0x01U   /* made for hook_gen == gen */
-#define CO_OD_COVER_VALIDATE   0x02U   /* a validate hook covers the object */
-#define CO_OD_COVER_NOTIFY     0x04U   /* a notify hook covers the object */
-#define CO_OD_COVER_READ_CHECK 0x08U   /* a read-check hook covers the object */
-#define CO_OD_COVER_DIRECT     0x10U   /* RAM value of a fixed-size type */
-#define CO_OD_COVER_CHECK      0x20U   /* limits or BOOLEAN: check the value */
-#define CO_OD_COVER_COPY       0x40U   /* the C storage is the wire format (memcpy) */
-#define CO_OD_COVER_EXACT      0x80U   /* every hook in [first, end) covers the object */
-#define CO_OD_COVER_MAP_W      0x100U  /* PDO/SRDO writers may write it (RPDO-mappable) */
-#define CO_OD_COVER_MAP_R      0x200U  /* PDO/SRDO readers may read it (TPDO-mappable) */
-#define CO_OD_COVER_NOTIFY1    0x400U  /* exactly one hook covers it, a notify hook */
-#define CO_OD_COVER_W_FAST     0x800U  /* a PDO/SRDO write: copy, then NOTIFY1's hook if set */
-#define CO_OD_COVER_R_FAST     0x1000U /* a PDO/SRDO read: copy */
-/** @endcond */
-
-/** @cond INTERNAL_HIDDEN */
-/* A position in the hook table: one byte when the table has fewer than 256 entries. */
-#if CO_OD_HOOKS_MAX < 256
-typedef uint8_t co_od_hook_pos_t;
-#else
-typedef uint16_t co_od_hook_pos_t;
-#endif
-/** @endcond */
-
-/**
- * @brief Hook coverage of one object; zero-initialise, then leave to the accessors.
- *
- * 8 bytes with fewer than 256 hooks. The generation stays a full co_od.hook_gen: a shorter
- * one would wrap and make a stale cover look fresh.
- */
-struct co_od_cover {
-	uint32_t gen;           /**< co_od.hook_gen when made (never 0: a zeroed cover is stale) */
-	co_od_hook_pos_t first; /**< position of the first hook covering the object */
-	co_od_hook_pos_t end;   /**< one past the last hook covering it (first = end: none) */
-	uint16_t flags;         /**< CO_OD_COVER_* */
+/** @brief How a PDO or SRDO moves a whole value of an object (co_od_move_of()). */
+enum co_od_move {
+	/** through co_od_write_info() / co_od_read_info() */
+	CO_OD_MOVE_ACCESS = 0,
+	/** a copy of the wire bytes to or from the RAM value (co_od_value_ptr()) */
+	CO_OD_MOVE_COPY,
+	/** a write: the copy, then co_od_notify() */
+	CO_OD_MOVE_COPY_NOTIFY,
 };
 
-/** @cond INTERNAL_HIDDEN */
-/* The whole of co_od_write_cached() / co_od_read_cached(), out of line. */
-uint32_t co_od_write_cover(struct co_od *od, const struct co_od_info *info,
-			   struct co_od_cover *cover, const void *data, size_t len,
-			   enum co_od_writer writer);
-uint32_t co_od_read_cover(const struct co_od *od, const struct co_od_info *info,
-			  struct co_od_cover *cover, void *buf, size_t cap, size_t *len,
-			  enum co_od_writer reader);
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-/* The lock rule (doc/architecture.md): stops the program when the node's mutex is not held. */
-void co_od_assert_locked(const struct co_od *od);
-#endif
-
-static inline bool co_od_cover_fast_(const struct co_od *od, const struct co_od_info *info,
-				     const struct co_od_cover *cover, uint16_t flag, size_t len,
-				     enum co_od_writer who)
-{
-	return cover->gen == od->hook_gen && (cover->flags & flag) != 0U && len == info->size &&
-	       (who == CO_OD_WRITER_PDO || who == CO_OD_WRITER_SRDO);
-}
-/** @endcond */
-
 /**
- * @brief Whether a PDO/SRDO write of the whole value through @p cover is, now, a copy of its
- * wire bytes followed by co_od_cover_notify() (fresh cover, plain value, no check, no
- * validate hook, at most one notify hook).
+ * @brief How a whole value of @p info moves for @p who (a PDO or SRDO writer or reader).
  *
- * For a mapping that moves several objects per frame (PDO): it may test this once for all
- * of them, copy, and call co_od_cover_notify() for each; as long as co_od.hook_gen is what it
- * was, the answer stands.
+ * A copy when the object is a RAM value of a fixed-size type whose C storage is its wire
+ * format, @p who may write (@p write) or read it, and nothing else would run: no limits or
+ * BOOLEAN check and no validate hook for a write, no read-check hook for a read. The answer
+ * stands while co_od.hook_gen is unchanged.
  */
-static inline bool co_od_cover_plain_write(const struct co_od *od, const struct co_od_cover *cover)
-{
-	return CO_OD_COVER && cover->gen == od->hook_gen &&
-	       (cover->flags & CO_OD_COVER_W_FAST) != 0U;
-}
-
-/** @brief As co_od_cover_plain_write(), for a PDO/SRDO read: a copy of the value. */
-static inline bool co_od_cover_plain_read(const struct co_od *od, const struct co_od_cover *cover)
-{
-	return CO_OD_COVER && cover->gen == od->hook_gen &&
-	       (cover->flags & CO_OD_COVER_R_FAST) != 0U;
-}
+enum co_od_move co_od_move_of(const struct co_od *od, const struct co_od_info *info,
+			      enum co_od_writer who, bool write);
 
 /**
- * @brief The notify pass of a plain write (co_od_cover_plain_write()) once the bytes are
- * copied: the one notify hook covering the object, if any.
+ * @brief The notify pass of a write: every notify hook of the object, in registration
+ * order, as co_od_write_info() runs it once the value is committed.
  */
-static inline void co_od_cover_notify(struct co_od *od, const struct co_od_info *info,
-				      const struct co_od_cover *cover, const void *data, size_t len,
-				      enum co_od_writer writer)
-{
-	if ((cover->flags & CO_OD_COVER_NOTIFY1) != 0U) {
-		/* The pass of one hook: nothing can follow it (od.c). */
-		const struct co_od_req req = {
-			.info = info, .writer = writer, .data = data, .len = len};
-		const struct co_od_hook_ent *h = &od->hooks[cover->first];
+void co_od_notify(struct co_od *od, const struct co_od_info *info, const void *data, size_t len,
+		  enum co_od_writer writer);
 
-		h->notify(od, &req, h->user_data);
-	}
-}
+/**
+ * @brief The one hook of an object, when it has exactly one and that one is a notify hook
+ * only: its position in co_od.hooks (valid while co_od.hook_gen is unchanged), else -1.
+ *
+ * Its notify pass is then one call of that hook (a hook it registers joins from the next
+ * write on), which a PDO resolves once instead of walking the object's hooks per frame.
+ */
+int co_od_notify_only(const struct co_od *od, const struct co_od_info *info);
 
 /**
  * @brief Copy a value of 1, 2, 4 or 8 bytes with constant lengths (inlined).
@@ -778,51 +712,6 @@ static inline bool co_od_copy_word(void *dst, const void *src, size_t n)
 	default:
 		return false;
 	}
-}
-
-/**
- * @brief co_od_write_info() of a whole value, using (and refreshing) @p cover.
- * @return as co_od_write_info()
- */
-static inline uint32_t co_od_write_cached(struct co_od *od, const struct co_od_info *info,
-					  struct co_od_cover *cover, const void *data, size_t len,
-					  enum co_od_writer writer)
-{
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-	co_od_assert_locked(od);
-#endif
-	if (!CO_OD_COVER) {
-		return co_od_write_info(od, info, data, len, writer);
-	}
-	if (co_od_cover_fast_(od, info, cover, CO_OD_COVER_W_FAST, len, writer) &&
-	    co_od_copy_word(od->ram + info->desc->offset, data, len)) {
-		co_od_cover_notify(od, info, cover, data, len, writer);
-		return 0U;
-	}
-	return co_od_write_cover(od, info, cover, data, len, writer);
-}
-
-/**
- * @brief co_od_read_info() from offset 0, using (and refreshing) @p cover.
- * @return as co_od_read_info()
- */
-static inline uint32_t co_od_read_cached(const struct co_od *od, const struct co_od_info *info,
-					 struct co_od_cover *cover, void *buf, size_t cap,
-					 size_t *len, enum co_od_writer reader)
-{
-#if defined(CONFIG_CANOPEN_LOCK_CHECK)
-	co_od_assert_locked(od);
-#endif
-	if (!CO_OD_COVER) {
-		return co_od_read_info(od, info, 0, buf, cap, len, reader);
-	}
-	if (cap >= info->size &&
-	    co_od_cover_fast_(od, info, cover, CO_OD_COVER_R_FAST, info->size, reader) &&
-	    co_od_copy_word(buf, od->ram + info->desc->offset, info->size)) {
-		*len = info->size;
-		return 0U;
-	}
-	return co_od_read_cover(od, info, cover, buf, cap, len, reader);
 }
 /** @} */
 

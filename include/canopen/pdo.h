@@ -115,58 +115,38 @@ typedef void (*co_tpdo_ind_t)(struct co_node *node, uint16_t num, void *user_dat
 #define CO_TPDOS 4
 #endif
 
-/* Whether a mapping entry keeps its object's whole co_od_info (CONFIG_CANOPEN_PDO_MAP_INFO). */
-#if defined(CONFIG_CANOPEN_PDO_MAP_INFO)
-#define CO_PDO_ENT_INFO 1
-#else
-#define CO_PDO_ENT_INFO 0
-#endif
+/* How a frame moves a mapped object (co_pdo_map_ent.move). */
+enum co_pdo_move {
+	CO_PDO_MOVE_SKIP = 0,    /* a dummy: its bits are skipped */
+	CO_PDO_MOVE_COPY,        /* a copy between the frame and the RAM value */
+	CO_PDO_MOVE_COPY_NOTIFY, /* an RPDO's copy, then the object's notify hooks */
+	CO_PDO_MOVE_COPY_HOOK,   /* an RPDO's copy, then its one hook, a notify hook (hook) */
+	CO_PDO_MOVE_ACCESS,      /* through the dictionary's accessors (checks, hooks, bits) */
+};
 
 /*
- * One mapped object, resolved once when the mapping is enabled. Without
- * CONFIG_CANOPEN_PDO_MAP_INFO an entry keeps what rebuilds its object's co_od_info when a
- * frame needs it (co_od_info_fill()), not the info itself: with the cover 16 instead of 32
- * bytes on a 32-bit target. The copy-only path of a frame needs the descriptor alone, and the
- * info only to call a notify hook.
+ * One mapped object, resolved once when the mapping is enabled: the object, and how a frame
+ * moves it as long as the dictionary's hooks stay as they were (co_pdo_map.hook_gen).
  */
 struct co_pdo_map_ent {
-#if CO_PDO_ENT_INFO
-	/* The object; info.index 0001h-0007h with no desc/prov marks a dummy entry. */
-	struct co_od_info info;
-#else
 	/* The object's descriptor; NULL for a dummy and for a provider's object. */
 	const struct co_od_sub *desc;
 	uint16_t index; /* object index; a dummy's: its type 0001h-0007h */
+	uint16_t entry; /* position of the object's dictionary entry, CO_OD_NO_ENTRY if none */
+	uint16_t hook;  /* CO_PDO_MOVE_COPY_HOOK: the hook's position in co_od.hooks */
 	uint8_t sub;    /* sub-index (0 for a dummy) */
-	/*
-	 * A dictionary object's object code (bits 0-3) and group (bits 4-5); a provider's
-	 * object: CO_PDO_ENT_PROV and its size in bytes, 1-8 (bits 0-3), as co_od_find()
-	 * describes it again at each access (pdo_internal.h).
-	 */
-	uint8_t kind;
-#endif
-#if CO_OD_COVER
-	struct co_od_cover cover; /* hooks covering the object, refreshed by the accessors */
-#endif
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	uint8_t bits; /* mapped length */
-	bool whole;   /* the whole object, whole bytes: moved without masking */
-#endif
-	/* Without bit-wise mapping an entry is always its whole object: the length is the
-	 * object's size (co_pdo_ent_bits()).
-	 */
+	uint8_t size;   /* object size on the wire in bytes, 1-8 (a dummy's: its type's) */
+	uint8_t bits;   /* mapped length in bits */
+	uint8_t move;   /* enum co_pdo_move */
 };
 
 /* A compiled mapping: entries in frame order, bit offsets implied by their lengths. */
 struct co_pdo_map {
 	struct co_pdo_map_ent ent[CO_PDO_MAP_ENTRIES];
-	/* co_od.hook_gen when every entry was found a plain copy, 0 if not (pdo_internal.h) */
-#if CO_OD_COVER
-	uint32_t fast_gen;
-#endif
-	uint8_t n;     /* entries in use */
-	uint8_t bits;  /* total mapped length, 0..64 */
-	bool bytewise; /* every entry is a whole number of bytes */
+	uint32_t hook_gen; /* co_od.hook_gen the moves were resolved at (0: not yet) */
+	uint8_t n;         /* entries in use */
+	uint8_t bits;      /* total mapped length, 0..64 */
+	bool bytewise;     /* every entry is a whole number of bytes */
 };
 
 struct co_rpdo {

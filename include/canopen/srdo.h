@@ -152,10 +152,12 @@ typedef void (*co_srdo_ind_t)(struct co_node *node, uint8_t srdo, bool safe,
 
 /** @cond INTERNAL_HIDDEN */
 #if defined(CONFIG_CANOPEN_SRDO)
-/* One mapped object, resolved once per entry into Operational. */
+/*
+ * One mapped object, resolved once per entry into Operational: its description, with which
+ * the accessors reach its value and its hooks without a lookup.
+ */
 struct co_srdo_ent {
 	struct co_od_info info;
-	struct co_od_cover cover;
 	uint8_t offset; /* in its frame */
 	uint8_t bytes;
 };

@@ -371,6 +371,8 @@ def write_c(model: Model, name: str):
         for o in groups[g]:
             h.extend(line + "\n" for line in obj_decl(o))
         h.append(f"\t}} {g};\n")
+    h.append("\t/* The node's first hook link of each entry (object dictionary, od_hooks.c). */\n"
+             f"\tuint16_t hook_heads[{len(objs) if objs else 1}];\n")
     h.append("};\n\n")
     h.append("/** Values of const objects (flash on a target). */\n")
     h.append(f"struct {p}_od_rom {{\n")
@@ -484,7 +486,7 @@ def write_c(model: Model, name: str):
              f"{c_multiline(eds_header_text(model).encode('utf-8'))};\n")
     c.append("#endif\n\n")
 
-    comm_end = "sizeof(struct %s_od_ram)" % p
+    comm_end = "offsetof(struct %s_od_ram, hook_heads)" % p
     for g in present:
         if not g.startswith("comm"):
             comm_end = f"offsetof(struct {p}_od_ram, {g})"
@@ -499,8 +501,9 @@ def write_c(model: Model, name: str):
              "#ifdef CONFIG_CANOPEN_OD_NAMES\n"
              f"\t.names = {p}_od_names,\n\t.eds_header = {p}_od_eds_header,\n"
              "#endif\n"
-             f"\t.ram_size = sizeof(struct {p}_od_ram),\n"
+             f"\t.ram_size = offsetof(struct {p}_od_ram, hook_heads),\n"
              f"\t.comm_end = {comm_end},\n"
+             f"\t.hook_heads = offsetof(struct {p}_od_ram, hook_heads),\n"
              f"\t.n_entries = {len(objs)}U,\n\t.n_nodeid = {len(nodeid)}U,\n"
              f"\t.n_subs = {pos}U,\n\t.max_staged = {P}_OD_MAX_STAGED,\n"
              f"\t.node_id = {P}_OD_NODE_ID,\n}};\n")

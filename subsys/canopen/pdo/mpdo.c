@@ -117,9 +117,6 @@ static enum co_mpdo_rx_result write_object(struct co_node *node, uint16_t index,
 		return CO_MPDO_RX_REFUSED;
 	}
 	co_pdo_ent_set(&ent, info);
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	ent.bits = (uint8_t)(info->size * 8U);
-#endif
 	memcpy(val, data, MPDO_MAX_BYTES);
 	return co_pdo_ent_write(&node->od, &ent, val, CO_OD_WRITER_MPDO) == 0U ? CO_MPDO_RX_WRITTEN
 									       : CO_MPDO_RX_REFUSED;

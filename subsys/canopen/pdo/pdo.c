@@ -169,9 +169,7 @@ static uint32_t map_build(struct co_node *node, bool rx, uint16_t num, uint8_t n
 		out->n = 0U;
 		out->bits = 0U;
 		out->bytewise = true;
-#if CO_OD_COVER
-		out->fast_gen = 0U;
-#endif
+		out->hook_gen = 0U;
 	}
 	if (n > CO_PDO_MAP_ENTRIES) {
 		return CO_SDO_AB_MAP_LEN;
@@ -638,6 +636,18 @@ static void cos_notify(struct co_od *od, const struct co_od_req *req, void *user
 	tpdo_event(t, co_node_time(t->node));
 }
 
+/*
+ * Whether @p n change-of-state hooks fit in place of the TPDO's present ones: a hook each,
+ * and at most a link each (one index of the dictionary, none for a provider's object).
+ */
+static bool cos_hooks_room(const struct co_node *node, const struct co_tpdo *t, uint32_t n)
+{
+	const struct co_od *od = &node->od;
+
+	return n <= (uint32_t)CO_OD_HOOKS_MAX - od->n_hooks + t->n_hooks &&
+	       n <= (uint32_t)CO_OD_HOOK_LINKS - od->n_links + t->n_hooks;
+}
+
 /* Hooks a mapping needs: one per run of consecutive sub-indexes of one object. */
 static uint8_t cos_hooks_needed(const struct co_pdo_map *map, uint8_t type)
 {
@@ -661,9 +671,7 @@ static uint8_t cos_hooks_needed(const struct co_pdo_map *map, uint8_t type)
 static uint32_t cos_hooks_fit(struct co_node *node, const struct co_tpdo *t,
 			      const struct co_pdo_map *map, uint8_t type)
 {
-	uint32_t free_slots = CO_OD_HOOKS_MAX - node->od.n_hooks + t->n_hooks;
-
-	return cos_hooks_needed(map, type) <= free_slots ? 0U : CO_SDO_AB_DEV_INCOMPAT;
+	return cos_hooks_room(node, t, cos_hooks_needed(map, type)) ? 0U : CO_SDO_AB_DEV_INCOMPAT;
 }
 
 static void cos_hooks_update(struct co_tpdo *t)
@@ -988,8 +996,7 @@ static uint32_t map_validate(struct co_od *od, struct co_od_req *req, void *user
 	uint8_t runs;
 	uint32_t ab = map_build(node, rx, num, (uint8_t)v, NULL, &runs);
 
-	if (ab == 0U && t != NULL && uses_events(t->type) &&
-	    runs > CO_OD_HOOKS_MAX - node->od.n_hooks + t->n_hooks) {
+	if (ab == 0U && t != NULL && uses_events(t->type) && !cos_hooks_room(node, t, runs)) {
 		/* No OD hook left for change-of-state detection of these objects. */
 		ab = CO_SDO_AB_DEV_INCOMPAT;
 	}

@@ -27,25 +27,6 @@
 #define CO_HOT_INLINE ALWAYS_INLINE
 #endif
 
-/*
- * An entry's hook-coverage cache for the cached accessors of od.h; without
- * CONFIG_CANOPEN_OD_COVER the entry has none and they do not use it.
- */
-#if CO_OD_COVER
-#define CO_PDO_ENT_COVER(ent) (&(ent)->cover)
-#else
-#define CO_PDO_ENT_COVER(ent) ((struct co_od_cover *)NULL)
-#endif
-
-/* Whether the copy-only path holds for @p map at hook generation @p gen (never without the
- * cache: the mapping then has no mark).
- */
-#if CO_OD_COVER
-#define CO_PDO_MAP_FAST(map, gen) ((map)->fast_gen == (gen))
-#else
-#define CO_PDO_MAP_FAST(map, gen) false
-#endif
-
 /* Largest data field of a classic CAN frame, in bits. */
 #define CO_PDO_MAX_BITS 64U
 
@@ -63,222 +44,74 @@
 uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 			  struct co_pdo_map_ent *ent);
 
-#if !CO_PDO_ENT_INFO
-/*
- * co_pdo_map_ent.kind (pdo.h): bit 7 a provider's object, whose size in bytes is in bits
- * 0-3; otherwise the object code in bits 0-3 and the group in bits 4-5.
- */
-static inline bool co_pdo_kind_prov(uint8_t kind)
-{
-	return (kind & 0x80U) != 0U;
-}
-
-static inline uint8_t co_pdo_kind_low(uint8_t kind)
-{
-	return kind & 0x0FU;
-}
-
-static inline uint8_t co_pdo_kind_group(uint8_t kind)
-{
-	return (uint8_t)(kind >> 4U) & 0x03U;
-}
-
-static inline uint8_t co_pdo_kind_of(const struct co_od_info *info)
-{
-	if (CO_OD_PROVIDERS && info->desc == NULL) {
-		/* A mapped object is a number of at most 8 bytes (co_pdo_map_check()). */
-		return (uint8_t)(0x80U | (info->size & 0x0FU));
-	}
-	return (uint8_t)((info->objcode & 0x0FU) | ((uint32_t)(info->group & 0x03U) << 4U));
-}
-#endif
-
 /* An entry's dictionary descriptor (NULL for a dummy and a provider's object). */
 static inline const struct co_od_sub *co_pdo_ent_desc(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_INFO
-	return ent->info.desc;
-#else
 	return ent->desc;
-#endif
 }
 
 /* Whether an entry is an object of a provider (never without providers). */
 static inline bool co_pdo_ent_is_prov(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_INFO
-	return CO_OD_PROVIDERS && ent->info.prov != NULL;
-#else
-	return CO_OD_PROVIDERS && co_pdo_kind_prov(ent->kind);
-#endif
+	return CO_OD_PROVIDERS && ent->desc == NULL && ent->index > 7U;
 }
 
 /* Whether an entry is a dummy (skips bits of an RPDO). */
 static inline bool co_pdo_ent_is_dummy(const struct co_pdo_map_ent *ent)
 {
-	return co_pdo_ent_desc(ent) == NULL && !co_pdo_ent_is_prov(ent);
+	return ent->desc == NULL && ent->index <= 7U;
 }
 
 /* An entry's object index (a dummy's: its type 0001h-0007h). */
 static inline uint16_t co_pdo_ent_index(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_INFO
-	return ent->info.index;
-#else
 	return ent->index;
-#endif
 }
 
 /* An entry's sub-index (0 for a dummy). */
 static inline uint8_t co_pdo_ent_sub(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_INFO
-	return ent->info.sub;
-#else
 	return ent->sub;
-#endif
 }
 
 /* An entry's object size on the wire in bytes (a dummy's: its type's whole bytes). */
 static inline uint32_t co_pdo_ent_size(const struct co_pdo_map_ent *ent)
 {
-#if CO_PDO_ENT_INFO
-	return ent->info.size;
-#else
-	if (ent->desc != NULL) {
-		return ent->desc->size;
-	}
-	if (co_pdo_ent_is_prov(ent)) {
-		return co_pdo_kind_low(ent->kind);
-	}
-	return co_dtype_size(ent->index);
-#endif
+	return ent->size;
 }
 
-/* The size of an entry of a dictionary object (a marked mapping's: co_pdo_ent_desc() set). */
-static inline uint32_t co_pdo_ent_desc_size(const struct co_pdo_map_ent *ent)
-{
-#if CO_PDO_ENT_INFO
-	return ent->info.size;
-#else
-	return ent->desc->size;
-#endif
-}
-
-/* Make @p ent a dummy entry of type @p index (0001h-0007h) of @p bytes whole bytes. */
-static inline void co_pdo_ent_set_dummy(struct co_pdo_map_ent *ent, uint16_t index, uint32_t bytes)
-{
-#if CO_PDO_ENT_INFO
-	ent->info.index = index;
-	ent->info.dtype = (uint8_t)index;
-	/* Its whole bytes: the length co_pdo_ent_bits() gives without bit-wise mapping. */
-	ent->info.size = bytes;
-#else
-	/* Its whole bytes are its type's size (co_pdo_ent_size()). */
-	(void)bytes;
-	ent->index = index;
-#endif
-}
-
-#if !CO_PDO_ENT_INFO
-/*
- * A provider's object is described again by co_od_find(), as when it was mapped (a
- * provider's description stays what it was while it is registered): 0 or its abort code.
- */
-uint32_t co_pdo_ent_prov_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
-			      struct co_od_info *tmp);
-#endif
-
-/*
- * The co_od_info of an entry that is not a dummy, for the accessors: its own, or rebuilt in
- * @p tmp from what a compact entry keeps; NULL if a provider no longer describes it.
- */
-static inline const struct co_od_info *
-co_pdo_ent_info(const struct co_od *od, const struct co_pdo_map_ent *ent, struct co_od_info *tmp)
-{
-#if CO_PDO_ENT_INFO
-	(void)od;
-	(void)tmp;
-	return &ent->info;
-#else
-	if (co_pdo_ent_is_prov(ent)) {
-		return co_pdo_ent_prov_info(od, ent, tmp) == 0U ? tmp : NULL;
-	}
-	co_od_info_fill(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
-			co_pdo_kind_group(ent->kind), tmp);
-	return tmp;
-#endif
-}
-
-/* As co_pdo_ent_info() for an entry with a descriptor, inline (the notify hooks of a frame). */
-static inline const struct co_od_info *co_pdo_ent_desc_info(const struct co_od *od,
-							    const struct co_pdo_map_ent *ent,
-							    struct co_od_info *tmp)
-{
-#if CO_PDO_ENT_INFO
-	(void)od;
-	(void)tmp;
-	return &ent->info;
-#elif defined(__OPTIMIZE_SIZE__)
-	co_od_info_fill(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
-			co_pdo_kind_group(ent->kind), tmp);
-	return tmp;
-#else
-	co_od_info_fill_inline(od, ent->desc, ent->index, co_pdo_kind_low(ent->kind),
-			       co_pdo_kind_group(ent->kind), tmp);
-	return tmp;
-#endif
-}
-
-/* Make @p ent the entry of the object @p info (from co_od_find(), mapped whole or in part). */
-static inline void co_pdo_ent_set(struct co_pdo_map_ent *ent, const struct co_od_info *info)
-{
-#if CO_PDO_ENT_INFO
-	ent->info = *info;
-#else
-	ent->desc = info->desc;
-	ent->index = info->index;
-	ent->sub = info->sub;
-	ent->kind = co_pdo_kind_of(info);
-#endif
-}
-
-/*
- * Mapped length of an entry in bits. Without bit-wise mapping co_pdo_map_check() lets only
- * whole objects in whole bytes through, and gives a dummy the size of its type, so the
- * length is the object's size and the entry does not store it.
- */
+/* Mapped length of an entry in bits. */
 static inline unsigned int co_pdo_ent_bits(const struct co_pdo_map_ent *ent)
 {
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	return ent->bits;
-#else
-	return co_pdo_ent_size(ent) * 8U;
-#endif
 }
 
 /* Whether an entry is its whole object in whole bytes (moved without masking). */
 static inline bool co_pdo_ent_whole(const struct co_pdo_map_ent *ent)
 {
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	return ent->whole;
-#else
-	return !co_pdo_ent_is_dummy(ent);
-#endif
+	return !co_pdo_ent_is_dummy(ent) && ent->bits == ent->size * 8U;
 }
 
+/* Make @p ent the entry of the object @p info (from co_od_find(), mapped whole or in part). */
+void co_pdo_ent_set(struct co_pdo_map_ent *ent, const struct co_od_info *info);
+
 /*
- * The entry functions below keep ent->cover (which OD hooks cover the object) up to date,
- * hence the non-const entries.
- *
+ * The co_od_info of an entry that is not a dummy, for the accessors and hooks: rebuilt in
+ * @p tmp from the descriptor, or described again by the provider (a provider's description
+ * stays what it was while it is registered); NULL if the provider no longer describes it.
+ */
+const struct co_od_info *co_pdo_ent_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
+					 struct co_od_info *tmp);
+
+/*
  * Read the mapped bits of an object as little-endian bytes into out[8] (zeroed above them).
  * Returns 0 or the reader's abort code (the bytes are then zero).
  */
-uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uint8_t out[8],
+uint32_t co_pdo_ent_read(const struct co_od *od, const struct co_pdo_map_ent *ent, uint8_t out[8],
 			 enum co_od_writer reader);
 
 /* Write the mapped bits (little-endian in val[8]) to the object; returns the abort code. */
-uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const uint8_t val[8],
+uint32_t co_pdo_ent_write(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t val[8],
 			  enum co_od_writer writer);
 
 /* Copy n bits of src (from bit 0) into dst at bit offset off; and the reverse. */
@@ -286,90 +119,141 @@ void co_pdo_bits_put(uint8_t *dst, unsigned int off, unsigned int n, const uint8
 void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8_t *dst);
 
 /*
- * Frames and objects. A mapping whose entries are all whole objects in whole bytes, each a
- * plain value for the PDO (co_od_cover_plain_write()/_read(): a copy, and for an RPDO at most
- * one notify hook), is marked with the hook generation at which it was found so
- * (map->fast_gen); while the dictionary's hook table stays as it was, a frame is a copy per
- * object and no per-object test. Anything else, and the first frame after a change, goes
- * through the cached accessors entry by entry (pdo_map.c), which then mark the mapping again.
+ * Frames and objects. Each entry of a mapping is resolved to how a frame moves it
+ * (co_pdo_map_ent.move, co_od_move_of()): a copy, for an RPDO a copy and the object's notify
+ * hooks, or the dictionary's accessors. The moves hold while the dictionary's hooks are what
+ * they were when they were resolved (co_pdo_map.hook_gen, compared once per frame).
  */
 
-/* The general path of co_pdo_map_pack() (pdo_map.c). */
-uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8]);
+/* Resolve every entry's move for the dictionary's hooks as they are now (pdo_map.c). */
+void co_pdo_map_resolve(const struct co_od *od, struct co_pdo_map *map, bool rx);
 
-/* The general path of co_pdo_map_unpack(), from entry @p from on at byte/bit offset @p off. */
-int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_t *data,
-			  uint8_t from, unsigned int off);
+/* A bit-wise mapping's frame (pdo_map.c). */
+uint8_t co_pdo_map_pack_bits(const struct co_od *od, const struct co_pdo_map *map, uint8_t data[8]);
+int co_pdo_map_unpack_bits(struct co_od *od, const struct co_pdo_map *map, const uint8_t *data);
+
+/* An entry moved through the accessors, whole bytes at @p at (pdo_map.c). */
+uint32_t co_pdo_ent_read_at(const struct co_od *od, const struct co_pdo_map_ent *ent, uint8_t *at);
+uint32_t co_pdo_ent_write_at(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t *at);
+/* An entry's notify hooks after its copy (pdo_map.c). */
+void co_pdo_ent_notify(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t *at);
+
+/*
+ * The frame paths: inline in the RPDO and SYNC paths when optimising for speed; in a size
+ * build (-Os) one copy each, in pdo_map.c (CO_PDO_FRAME_DEFINE).
+ */
+#if defined(__OPTIMIZE_SIZE__) && !defined(CO_PDO_FRAME_DEFINE)
+uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8]);
+int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data);
+#else
+#if defined(__OPTIMIZE_SIZE__)
+#define CO_PDO_FRAME_FN
+#else
+#define CO_PDO_FRAME_FN static ALWAYS_INLINE
+#endif
 
 /* Sample every mapped object into data[8] (zero above the mapped bits); returns the frame
  * length in bytes. A refused read leaves zeros.
  */
-static CO_HOT_INLINE uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
-					     uint8_t data[8])
+CO_PDO_FRAME_FN uint8_t co_pdo_map_pack(const struct co_od *od, struct co_pdo_map *map,
+					uint8_t data[8])
 {
-#if CO_OD_COVER
-	if (likely(CO_PDO_MAP_FAST(map, od->hook_gen))) {
-		uint8_t frame[8] = {0};
-		unsigned int off = 0;
-
-		for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
-			/* A marked mapping holds whole dictionary objects only. */
-			unsigned int bytes = co_pdo_ent_desc_size(ent);
-
-			(void)co_od_copy_word(&frame[off], od->ram + co_pdo_ent_desc(ent)->offset,
-					      bytes);
-			off += bytes;
-		}
-		memcpy(data, frame, sizeof(frame));
-		return (uint8_t)(off);
+	if (unlikely(map->hook_gen != od->hook_gen)) {
+		co_pdo_map_resolve(od, map, false);
 	}
-#endif
-	return co_pdo_map_pack_gen(od, map, data);
+	if (unlikely(!map->bytewise)) {
+		return co_pdo_map_pack_bits(od, map, data);
+	}
+	uint8_t frame[8] = {0};
+	unsigned int off = 0;
+
+	for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
+		if (likely(ent->move == CO_PDO_MOVE_COPY)) {
+			(void)co_od_copy_word(&frame[off], od->ram + ent->desc->offset, ent->size);
+		} else {
+			(void)co_pdo_ent_read_at(od, ent, &frame[off]);
+		}
+		off += ent->bits / 8U;
+	}
+	memcpy(data, frame, sizeof(frame));
+	return (uint8_t)off;
 }
 
 /*
  * Write every mapped object from data (at least the mapped bytes long); dummies are skipped.
  * Returns the number of objects whose write was refused.
  */
-static CO_HOT_INLINE int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map,
-					   const uint8_t *data)
+CO_PDO_FRAME_FN int co_pdo_map_unpack(struct co_od *od, struct co_pdo_map *map, const uint8_t *data)
 {
-#if CO_OD_COVER
-	uint32_t gen = od->hook_gen;
-
-	if (likely(CO_PDO_MAP_FAST(map, gen))) {
-		unsigned int off = 0;
-
-		for (uint8_t i = 0; i < map->n; i++) {
-			struct co_pdo_map_ent *ent = &map->ent[i];
-			unsigned int bytes = co_pdo_ent_desc_size(ent);
-
-			(void)co_od_copy_word(od->ram + co_pdo_ent_desc(ent)->offset, &data[off],
-					      bytes);
-#if CO_PDO_ENT_INFO
-			co_od_cover_notify(od, &ent->info, &ent->cover, &data[off], bytes,
-					   CO_OD_WRITER_PDO);
-#else
-			if ((ent->cover.flags & CO_OD_COVER_NOTIFY1) != 0U) {
-				/* The hook sees the object as co_od_find() describes it. */
-				struct co_od_info tmp;
-
-				co_od_cover_notify(od, co_pdo_ent_desc_info(od, ent, &tmp),
-						   &ent->cover, &data[off], bytes,
-						   CO_OD_WRITER_PDO);
-			}
-#endif
-			off += bytes;
-			/* A hook that changed the hook table: the rest entry by entry. */
-			if (unlikely(od->hook_gen != gen)) {
-				return co_pdo_map_unpack_gen(od, map, data, i + 1U, off);
-			}
-		}
-		return 0;
+	if (unlikely(map->hook_gen != od->hook_gen)) {
+		co_pdo_map_resolve(od, map, true);
 	}
-#endif
-	return co_pdo_map_unpack_gen(od, map, data, 0U, 0U);
+	if (unlikely(!map->bytewise)) {
+		return co_pdo_map_unpack_bits(od, map, data);
+	}
+	unsigned int off = 0;
+	int refused = 0;
+
+	for (const struct co_pdo_map_ent *ent = map->ent; ent < map->ent + map->n; ent++) {
+		switch (ent->move) {
+		case CO_PDO_MOVE_COPY:
+			(void)co_od_copy_word(od->ram + ent->desc->offset, &data[off], ent->size);
+			break;
+		case CO_PDO_MOVE_COPY_HOOK: {
+			(void)co_od_copy_word(od->ram + ent->desc->offset, &data[off], ent->size);
+			/*
+			 * The pass of the object's one hook: one call (od.h, co_od_notify_only()).
+			 * It sees the object as co_od_find() describes it; a copied object has no
+			 * limits and no provider.
+			 */
+			const struct co_od_entry *e = &od->def->entries[ent->entry];
+			const struct co_od_info info = {
+				.desc = ent->desc,
+				.size = ent->size,
+				.index = ent->index,
+				.sub = ent->sub,
+				.dtype = ent->desc->dtype,
+				.access = ent->desc->access,
+				.flags = ent->desc->flags,
+				.objcode = e->objcode,
+				.group = e->group,
+				.entry = ent->entry,
+			};
+			const struct co_od_req req = {.info = &info,
+						      .writer = CO_OD_WRITER_PDO,
+						      .data = &data[off],
+						      .len = ent->size};
+			const struct co_od_hook *h = &od->hooks[ent->hook].hook;
+
+			h->notify(od, &req, h->user_data);
+			if (unlikely(map->hook_gen != od->hook_gen)) {
+				co_pdo_map_resolve(od, map, true);
+			}
+			break;
+		}
+		case CO_PDO_MOVE_COPY_NOTIFY:
+			(void)co_od_copy_word(od->ram + ent->desc->offset, &data[off], ent->size);
+			co_pdo_ent_notify(od, ent, &data[off]);
+			/* A hook that changed the hooks: the next entries' moves are resolved
+			 * again. */
+			if (unlikely(map->hook_gen != od->hook_gen)) {
+				co_pdo_map_resolve(od, map, true);
+			}
+			break;
+		case CO_PDO_MOVE_ACCESS:
+			refused += co_pdo_ent_write_at(od, ent, &data[off]) != 0U;
+			if (unlikely(map->hook_gen != od->hook_gen)) {
+				co_pdo_map_resolve(od, map, true);
+			}
+			break;
+		default:
+			break;
+		}
+		off += ent->bits / 8U;
+	}
+	return refused;
 }
+#endif /* the frame paths */
 
 struct co_node;
 struct can_frame;

@@ -13,6 +13,8 @@
 
 #include <zephyr/kernel.h>
 
+/* The one copy of the frame paths in a size build (pdo_internal.h). */
+#define CO_PDO_FRAME_DEFINE
 #include "pdo_internal.h"
 
 /* Length in bits of the dummy types 0001h-0007h (CiA 301 §7.4.7.1). */
@@ -50,16 +52,17 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 	bool bitwise = IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING);
 
 	memset(ent, 0, sizeof(*ent));
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 	ent->bits = bits;
-#endif
 	if (index >= 1U && index <= 7U) {
 		/* Dummy entries only skip bits of received frames. */
 		if (!rx || sub != 0U || bits != dummy_bits[index] ||
 		    (!bitwise && bits % 8U != 0U)) {
 			return CO_SDO_AB_NO_MAP;
 		}
-		co_pdo_ent_set_dummy(ent, index, (uint32_t)bits / 8U);
+		ent->index = index;
+		ent->entry = CO_OD_NO_ENTRY;
+		ent->size = (uint8_t)(bits / 8U);
+		ent->move = CO_PDO_MOVE_SKIP;
 		return 0U;
 	}
 	struct co_od_info tmp;
@@ -70,6 +73,7 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 		return ab;
 	}
 	co_pdo_ent_set(ent, info);
+	ent->bits = bits;
 	if (!mappable(info, rx) || bits == 0U) {
 		return CO_SDO_AB_NO_MAP;
 	}
@@ -85,9 +89,6 @@ uint32_t co_pdo_map_check(const struct co_od *od, bool rx, uint32_t entry,
 	if (bits < size_bits && (!bitwise || co_dtype_size(info->dtype) == 0U)) {
 		return CO_SDO_AB_NO_MAP;
 	}
-#if defined(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
-	ent->whole = bits == size_bits;
-#endif
 	return 0U;
 }
 
@@ -119,15 +120,29 @@ void co_pdo_bits_get(const uint8_t *src, unsigned int off, unsigned int n, uint8
 	}
 }
 
-#if !CO_PDO_ENT_INFO
-uint32_t co_pdo_ent_prov_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
-			      struct co_od_info *tmp)
+void co_pdo_ent_set(struct co_pdo_map_ent *ent, const struct co_od_info *info)
 {
-	return co_od_find(od, ent->index, ent->sub, tmp);
+	ent->desc = CO_OD_PROVIDERS && info->prov != NULL ? NULL : info->desc;
+	ent->index = info->index;
+	ent->entry = info->entry;
+	ent->sub = info->sub;
+	/* A mapped object is a number of at most 8 bytes (co_pdo_map_check()). */
+	ent->size = (uint8_t)(info->size <= 8U ? info->size : 8U);
+	ent->bits = (uint8_t)(ent->size * 8U);
+	ent->move = CO_PDO_MOVE_ACCESS;
 }
-#endif
 
-uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uint8_t out[8],
+const struct co_od_info *co_pdo_ent_info(const struct co_od *od, const struct co_pdo_map_ent *ent,
+					 struct co_od_info *tmp)
+{
+	if (ent->desc == NULL) {
+		return co_od_find(od, ent->index, ent->sub, tmp) == 0U ? tmp : NULL;
+	}
+	co_od_info_fill(od, ent->entry, ent->desc, tmp);
+	return tmp;
+}
+
+uint32_t co_pdo_ent_read(const struct co_od *od, const struct co_pdo_map_ent *ent, uint8_t out[8],
 			 enum co_od_writer reader)
 {
 	size_t len = 0;
@@ -142,7 +157,7 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 	}
 	size_t cap = info->size < 8U ? info->size : 8U;
 
-	ab = co_od_read_cached(od, info, CO_PDO_ENT_COVER(ent), out, cap, &len, reader);
+	ab = co_od_read_info(od, info, 0U, out, cap, &len, reader);
 	if (ab != 0U) {
 		memset(out, 0, 8);
 		return ab;
@@ -158,7 +173,7 @@ uint32_t co_pdo_ent_read(const struct co_od *od, struct co_pdo_map_ent *ent, uin
 	return 0U;
 }
 
-uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const uint8_t val[8],
+uint32_t co_pdo_ent_write(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t val[8],
 			  enum co_od_writer writer)
 {
 	uint8_t buf[8];
@@ -178,117 +193,113 @@ uint32_t co_pdo_ent_write(struct co_od *od, struct co_pdo_map_ent *ent, const ui
 			buf[b / 8U] |= (uint8_t)(1U << (b % 8U));
 		}
 	}
-	return co_od_write_cached(od, info, CO_PDO_ENT_COVER(ent), buf, size, writer);
+	return co_od_write_info(od, info, buf, size, writer);
 }
 
-#if CO_OD_COVER
-/* Whether every entry of a mapping is a plain copy now (see pdo_internal.h). */
-static bool map_plain(const struct co_od *od, const struct co_pdo_map *map, bool rx)
+uint32_t co_pdo_ent_read_at(const struct co_od *od, const struct co_pdo_map_ent *ent, uint8_t *at)
 {
-	if (!map->bytewise) {
-		return false;
-	}
-	for (uint8_t i = 0; i < map->n; i++) {
-		const struct co_pdo_map_ent *ent = &map->ent[i];
-		unsigned int bytes = co_pdo_ent_bits(ent) / 8U;
+	uint8_t val[8];
+	uint32_t ab = co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
 
-		if (!co_pdo_ent_whole(ent) || co_pdo_ent_desc(ent) == NULL ||
-		    (bytes != 1U && bytes != 2U && bytes != 4U && bytes != 8U) ||
-		    !(rx ? co_od_cover_plain_write(od, CO_PDO_ENT_COVER(ent))
-			 : co_od_cover_plain_read(od, CO_PDO_ENT_COVER(ent)))) {
-			return false;
+	/* A refused read leaves zeros (val is zeroed then). */
+	memcpy(at, val, co_pdo_ent_bits(ent) / 8U);
+	return ab;
+}
+
+uint32_t co_pdo_ent_write_at(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t *at)
+{
+	uint8_t val[8] = {0};
+
+	memcpy(val, at, co_pdo_ent_bits(ent) / 8U);
+	return co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO);
+}
+
+void co_pdo_ent_notify(struct co_od *od, const struct co_pdo_map_ent *ent, const uint8_t *at)
+{
+	struct co_od_info info;
+
+	/* The hooks see the object as co_od_find() describes it. */
+	co_od_info_fill(od, ent->entry, ent->desc, &info);
+	co_od_notify(od, &info, at, ent->size, CO_OD_WRITER_PDO);
+}
+
+void co_pdo_map_resolve(const struct co_od *od, struct co_pdo_map *map, bool rx)
+{
+	for (uint8_t i = 0; i < map->n; i++) {
+		struct co_pdo_map_ent *ent = &map->ent[i];
+		struct co_od_info info;
+		enum co_od_move move;
+
+		if (co_pdo_ent_is_dummy(ent)) {
+			ent->move = CO_PDO_MOVE_SKIP;
+			continue;
+		}
+		ent->move = CO_PDO_MOVE_ACCESS;
+		/* A copy moves whole values of 1, 2, 4 or 8 bytes of the dictionary. */
+		if (ent->desc == NULL || !co_pdo_ent_whole(ent) ||
+		    (ent->size != 1U && ent->size != 2U && ent->size != 4U && ent->size != 8U)) {
+			continue;
+		}
+		co_od_info_fill(od, ent->entry, ent->desc, &info);
+		move = co_od_move_of(od, &info, CO_OD_WRITER_PDO, rx);
+		if (move == CO_OD_MOVE_COPY) {
+			ent->move = CO_PDO_MOVE_COPY;
+		} else if (move == CO_OD_MOVE_COPY_NOTIFY) {
+			int hook = co_od_notify_only(od, &info);
+
+			ent->move = hook >= 0 ? CO_PDO_MOVE_COPY_HOOK : CO_PDO_MOVE_COPY_NOTIFY;
+			ent->hook = hook >= 0 ? (uint16_t)hook : 0U;
+		} else {
+			/* through the accessors */
 		}
 	}
-	return true;
+	map->hook_gen = od->hook_gen;
 }
-
-/* Mark a mapping for the copy-only path when every entry is a plain copy now. */
-static void map_mark(const struct co_od *od, struct co_pdo_map *map, bool rx)
-{
-	map->fast_gen = map_plain(od, map, rx) ? od->hook_gen : 0U;
-}
-#else
-/* Without the cache no mapping is marked. */
-static inline void map_mark(const struct co_od *od, struct co_pdo_map *map, bool rx)
-{
-	(void)od;
-	(void)map;
-	(void)rx;
-}
-#endif
 
 /*
  * Without bit-wise mapping co_pdo_map_check() lets through whole objects in whole bytes and
- * (RPDOs) dummies only: the per-bit and part-of-an-object paths below cannot be taken, and
- * leaving them out of such a build saves their code.
+ * (RPDOs) dummies only, so every mapping is byte-wise and the per-bit paths below are not
+ * taken; leaving them out of such a build saves their code.
  */
 #define BITWISE IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)
 
-uint8_t co_pdo_map_pack_gen(const struct co_od *od, struct co_pdo_map *map, uint8_t data[8])
+uint8_t co_pdo_map_pack_bits(const struct co_od *od, const struct co_pdo_map *map, uint8_t data[8])
 {
 	uint8_t val[8];
 	unsigned int off = 0;
 
 	memset(data, 0, 8);
+	if (!BITWISE) {
+		return 0U;
+	}
 	for (uint8_t i = 0; i < map->n; i++) {
-		struct co_pdo_map_ent *ent = &map->ent[i];
-		size_t len;
-		struct co_od_info tmp;
+		const struct co_pdo_map_ent *ent = &map->ent[i];
 
-		if (!BITWISE || (map->bytewise && co_pdo_ent_whole(ent))) {
-			/* Straight into the frame: the mapping check made the sizes fit. */
-			const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
-
-			if (info == NULL ||
-			    co_od_read_cached(od, info, CO_PDO_ENT_COVER(ent), &data[off / 8U],
-					      co_pdo_ent_bits(ent) / 8U, &len,
-					      CO_OD_WRITER_PDO) != 0U) {
-				memset(&data[off / 8U], 0, co_pdo_ent_bits(ent) / 8U);
-			}
-		} else {
-			(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
-			if (map->bytewise) {
-				memcpy(&data[off / 8U], val, co_pdo_ent_bits(ent) / 8U);
-			} else {
-				co_pdo_bits_put(data, off, co_pdo_ent_bits(ent), val);
-			}
-		}
+		(void)co_pdo_ent_read(od, ent, val, CO_OD_WRITER_PDO);
+		co_pdo_bits_put(data, off, co_pdo_ent_bits(ent), val);
 		off += co_pdo_ent_bits(ent);
 	}
-	map_mark(od, map, false);
 	return (uint8_t)((map->bits + 7U) / 8U);
 }
 
-int co_pdo_map_unpack_gen(struct co_od *od, struct co_pdo_map *map, const uint8_t *data,
-			  uint8_t from, unsigned int off)
+int co_pdo_map_unpack_bits(struct co_od *od, const struct co_pdo_map *map, const uint8_t *data)
 {
 	uint8_t val[8];
+	unsigned int off = 0;
 	int refused = 0;
 
-	/* Byte-wise mappings count bytes, bit-wise ones bits. */
-	for (uint8_t i = from; i < map->n; i++) {
-		struct co_pdo_map_ent *ent = &map->ent[i];
-		struct co_od_info tmp;
+	if (!BITWISE) {
+		return 0;
+	}
+	for (uint8_t i = 0; i < map->n; i++) {
+		const struct co_pdo_map_ent *ent = &map->ent[i];
 
-		if (BITWISE ? map->bytewise && co_pdo_ent_whole(ent) : !co_pdo_ent_is_dummy(ent)) {
-			/* A whole object in whole bytes: its wire value is in the frame. */
-			const struct co_od_info *info = co_pdo_ent_info(od, ent, &tmp);
-
-			refused += info == NULL ||
-				   co_od_write_cached(od, info, CO_PDO_ENT_COVER(ent), &data[off],
-						      co_pdo_ent_bits(ent) / 8U,
-						      CO_OD_WRITER_PDO) != 0U;
-		} else if (BITWISE && !co_pdo_ent_is_dummy(ent)) {
+		if (!co_pdo_ent_is_dummy(ent)) {
 			memset(val, 0, sizeof(val));
-			if (map->bytewise) {
-				memcpy(val, &data[off], co_pdo_ent_bits(ent) / 8U);
-			} else {
-				co_pdo_bits_get(data, off, co_pdo_ent_bits(ent), val);
-			}
+			co_pdo_bits_get(data, off, co_pdo_ent_bits(ent), val);
 			refused += co_pdo_ent_write(od, ent, val, CO_OD_WRITER_PDO) != 0U;
 		}
-		off += map->bytewise ? co_pdo_ent_bits(ent) / 8U : co_pdo_ent_bits(ent);
+		off += co_pdo_ent_bits(ent);
 	}
-	map_mark(od, map, true);
 	return refused;
 }

@@ -391,8 +391,8 @@ static bool pack(struct co_node *node, struct co_srdo_inst *in, struct can_frame
 		struct co_srdo_ent *e = &in->ent[i];
 		size_t len = 0;
 
-		if (co_od_read_cached(&node->od, &e->info, &e->cover, &f[i % 2U].data[e->offset],
-				      e->bytes, &len, CO_OD_WRITER_SRDO) != 0U) {
+		if (co_od_read_info(&node->od, &e->info, 0U, &f[i % 2U].data[e->offset], e->bytes,
+				    &len, CO_OD_WRITER_SRDO) != 0U) {
 			return false;
 		}
 	}
@@ -523,8 +523,8 @@ static void rx_inverted(struct co_rx *rx, const struct can_frame *frame, uint64_
 		struct co_srdo_ent *e = &in->ent[i];
 		const uint8_t *src = i % 2U == 0U ? in->normal : frame->data;
 
-		(void)co_od_write_cached(&node->od, &e->info, &e->cover, &src[e->offset], e->bytes,
-					 CO_OD_WRITER_SRDO);
+		(void)co_od_write_info(&node->od, &e->info, &src[e->offset], e->bytes,
+				       CO_OD_WRITER_SRDO);
 	}
 	in->sct_deadline = now_us + in->cycle_us;
 	consumer_arm(in);

@@ -115,11 +115,9 @@ def test_three_configurations_measured(tmp_path):
         assert c["kconfig"]["CONFIG_CANOPEN_LINE_RX_SLOTS"] in ("16", "32"), "embedded defaults"
     assert "per_rpdo" in configs["minimal"]["ram"] and "per_sdo_srv" in configs["minimal"]["ram"]
     assert "subsys/canopen/pdo/mpdo.c" not in {f["file"] for f in configs["minimal"]["files"]}
-    # The minimal slave leaves out the OD's providers and hook-coverage cache; the others keep
-    # the defaults.
-    for opt in ("CONFIG_CANOPEN_OD_PROVIDERS", "CONFIG_CANOPEN_OD_COVER"):
-        assert configs["minimal"]["kconfig"][opt] == "n"
-        assert configs["full"]["kconfig"][opt] == "y"
+    # The minimal slave leaves out the OD's providers; the others keep the default.
+    assert configs["minimal"]["kconfig"]["CONFIG_CANOPEN_OD_PROVIDERS"] == "n"
+    assert configs["full"]["kconfig"]["CONFIG_CANOPEN_OD_PROVIDERS"] == "y"
     assert "subsys/canopen/srdo/srdo.c" in {f["file"] for f in configs["full"]["files"]}
     assert configs["full"]["lines"] == 2, "redundancy: a second line"
     assert configs["minimal"]["target"] == {"code": 12 * 1024, "ram": 2 * 1024}

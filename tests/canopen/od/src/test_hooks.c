@@ -151,13 +151,12 @@ ZTEST(od_hooks, test_several_hooks_all_must_accept)
 	b.refuse = 0;
 	log.n_order = 0;
 	zassert_ok(co_od_set_u32(&fx.od, 0x1005, 0, 0x81, CO_OD_WRITER_SDO));
-	/* Hooks run in table order (sorted by first index, so b before a): validates, then
-	 * notifies. */
+	/* Hooks run in registration order (a, then the wider b): validates, then notifies. */
 	zassert_equal(log.n_order, 4);
-	zassert_equal(log.order[0], 2);
-	zassert_equal(log.order[1], 1);
-	zassert_equal(log.order[2], 12);
-	zassert_equal(log.order[3], 11);
+	zassert_equal(log.order[0], 1);
+	zassert_equal(log.order[1], 2);
+	zassert_equal(log.order[2], 11);
+	zassert_equal(log.order[3], 12);
 }
 
 static uint32_t handled(struct co_od *od, struct co_od_req *req, void *user_data)
@@ -221,11 +220,10 @@ static uint32_t rc_refuse(const struct co_od *od, const struct co_od_info *info,
 }
 
 /*
- * A hook's read check takes a table entry of its own, after its validate and notify entry:
- * such a hook needs two free entries, counts as one hook when removed, and keeps its place in
- * the order of the validate and notify hooks.
+ * A hook with a read check is one hook like any other: it takes one table entry, runs in
+ * registration order with the others, and is removed whole.
  */
-ZTEST(od_hooks, test_a_hook_with_a_read_check_takes_two_entries)
+ZTEST(od_hooks, test_a_hook_with_a_read_check_is_one_hook)
 {
 	struct rec log = {0};
 	struct rec a = {.id = 1, .log = &log};
@@ -245,19 +243,15 @@ ZTEST(od_hooks, test_a_hook_with_a_read_check_takes_two_entries)
 	size_t len;
 
 	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &a));
-	for (int i = 1; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 1; i++) {
+	for (int i = 1; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 2; i++) {
 		zassert_ok(hook(&fx.od, 0x2000 + i, 0x2000 + i, 0, 0, &fill));
 	}
-	zassert_equal(co_od_hook_register(&fx.od, &with_check), -ENOSPC, "one entry is free");
-	zassert_equal(co_od_hook_unregister(&fx.od, &fill), CONFIG_CANOPEN_OD_HOOKS_MAX - 2);
-	for (int i = 1; i < CONFIG_CANOPEN_OD_HOOKS_MAX - 3; i++) {
-		zassert_ok(hook(&fx.od, 0x2000 + i, 0x2000 + i, 0, 0, &fill));
-	}
-	/* Three entries free: the hook with its check, then one more. */
+	/* Two entries free: the hook with its check, then one more. */
 	rc_calls = 0;
 	zassert_ok(co_od_hook_register(&fx.od, &with_check));
 	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &c));
 	zassert_equal(hook(&fx.od, 0x1017, 0x1017, 0, 0, &rc), -ENOSPC, "the table is full");
+	zassert_equal(co_od_hook_unregister(&fx.od, &fill), CONFIG_CANOPEN_OD_HOOKS_MAX - 3);
 
 	zassert_equal(co_od_read(&fx.od, 0x1017, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_SDO),
 		      CO_SDO_AB_NO_DATA, "the read check runs");
@@ -269,12 +263,9 @@ ZTEST(od_hooks, test_a_hook_with_a_read_check_takes_two_entries)
 
 	zassert_mem_equal(log.order, expected, sizeof(expected), "registration order");
 
-	zassert_equal(co_od_hook_unregister(&fx.od, &b), 1, "one hook, two entries");
+	zassert_equal(co_od_hook_unregister(&fx.od, &b), 1, "one hook");
 	zassert_ok(co_od_read(&fx.od, 0x1017, 0, 0, buf, sizeof(buf), &len, CO_OD_WRITER_SDO));
 	zassert_equal(rc_calls, 1, "a removed read check does not run");
-	zassert_ok(hook(&fx.od, 0x1017, 0x1017, 0, 0, &rc));
-	zassert_ok(hook(&fx.od, 0x1018, 0x1018, 0, 0, &rc), "both entries were freed");
-	zassert_equal(hook(&fx.od, 0x1018, 0x1018, 0, 0, &rc), -ENOSPC);
 }
 
 ZTEST(od_hooks, test_hooks_are_per_node)

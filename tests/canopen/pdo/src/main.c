@@ -493,6 +493,7 @@ static void assert_info_is_found(const struct co_od_info *seen, uint16_t index, 
 	zassert_equal(seen->flags, found.flags);
 	zassert_equal(seen->objcode, found.objcode, "%04Xh:%u", index, sub);
 	zassert_equal(seen->group, found.group);
+	zassert_equal(seen->entry, found.entry);
 }
 
 ZTEST(co_pdo, test_rpdo_hooks_see_the_mapped_objects_as_found)
@@ -519,27 +520,99 @@ ZTEST(co_pdo, test_rpdo_hooks_see_the_mapped_objects_as_found)
 	co_node_unlock(&t.node);
 }
 
-/*
- * Without CONFIG_CANOPEN_PDO_MAP_INFO a mapping entry keeps what rebuilds its object's
- * co_od_info, not the info itself: a pointer and four bytes, and the cover beside them when
- * the build has one.
- */
-ZTEST(co_pdo, test_map_entry_compact)
+/* A notify hook alone on each object (the copy path) sees them as co_od_find() does too. */
+static void record_notified(struct co_od *od, const struct co_od_req *req, void *user_data)
 {
-	size_t want = sizeof(void *) + 4U;
+	if (n_seen < 2) {
+		seen_info[n_seen] = *req->info;
+	}
+	n_seen++;
+}
 
-	zassert_equal(CO_PDO_ENT_INFO, IS_ENABLED(CONFIG_CANOPEN_PDO_MAP_INFO));
-	if (CO_PDO_ENT_INFO) {
-		zassert_true(sizeof(struct co_pdo_map_ent) >= sizeof(struct co_od_info));
-		return;
-	}
-	if (IS_ENABLED(CONFIG_CANOPEN_OD_COVER)) {
-		want += sizeof(struct co_od_cover);
-	}
-	zassert_true(sizeof(struct co_pdo_map_ent) < sizeof(struct co_od_info));
-	if (!IS_ENABLED(CONFIG_CANOPEN_PDO_BITWISE_MAPPING)) {
-		zassert_equal(sizeof(struct co_pdo_map_ent), ROUND_UP(want, sizeof(void *)));
-	}
+ZTEST(co_pdo, test_rpdo_notify_hooks_see_the_mapped_objects_as_found)
+{
+	const struct co_od_hook rec[2] = {
+		{0x2000, 0x2000, 1, 1, NULL, record_notified, &n_seen},
+		{0x2001, 0x2001, 0, 0, NULL, record_notified, &n_seen},
+	};
+
+	n_seen = 0;
+	memset(seen_info, 0xA5, sizeof(seen_info));
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &rec[0]));
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &rec[1]));
+	co_node_unlock(&t.node);
+	go_operational();
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x51, 0x52, 0x53});
+	zassert_equal(n_seen, 2, "one notify call per mapped object");
+	assert_info_is_found(&seen_info[0], 0x2000, 1);
+	assert_info_is_found(&seen_info[1], 0x2001, 0);
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &n_seen), 2);
+	co_node_unlock(&t.node);
+}
+
+/*
+ * A mapping entry keeps what an access needs and no more, the same on every board: the
+ * object's descriptor, index, entry position, sub-index, size, mapped length, move and hook.
+ */
+ZTEST(co_pdo, test_map_entry_layout)
+{
+	zassert_equal(sizeof(struct co_pdo_map_ent),
+		      ROUND_UP(sizeof(void *) + 10U, sizeof(void *)));
+}
+
+/*
+ * The moves of a mapping are resolved when it is mapped and again after the hooks changed: a
+ * hook registered on a mapped object once the PDO ran is run by its next frame, and once
+ * removed it is run no more.
+ */
+static int late_notified;
+static uint16_t late_value;
+
+static void late_notify(struct co_od *od, const struct co_od_req *req, void *user_data)
+{
+	late_notified++;
+	late_value = (uint16_t)co_od_req_uint(req);
+}
+
+static uint32_t late_refuse(struct co_od *od, struct co_od_req *req, void *user_data)
+{
+	return CO_SDO_AB_DATA_DEV_STATE;
+}
+
+ZTEST(co_pdo, test_hooks_registered_after_mapping_run_on_the_next_frame)
+{
+	const struct co_od_hook notify = {0x2001, 0x2001, 0, 0, NULL, late_notify, &late_notified};
+	const struct co_od_hook refuse = {0x2001, 0x2001, 0, 0, late_refuse, NULL, &late_value};
+
+	late_notified = 0;
+	go_operational();
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x11, 0x22, 0x33});
+	zassert_equal(get_u16(0x2001, 0), 0x3322);
+
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &notify));
+	co_node_unlock(&t.node);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x12, 0x23, 0x34});
+	zassert_equal(late_notified, 1, "the new notify hook runs on the next frame");
+	zassert_equal(late_value, 0x3423);
+
+	co_node_lock(&t.node);
+	zassert_ok(co_od_hook_register(co_node_od(&t.node), &refuse));
+	co_node_unlock(&t.node);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x13, 0x24, 0x35});
+	zassert_equal(get_u8(0x2000, 1), 0x13);
+	zassert_equal(get_u16(0x2001, 0), 0x3423, "the new validate hook refused the write");
+	zassert_equal(late_notified, 1, "and nothing was notified");
+
+	co_node_lock(&t.node);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &late_value), 1);
+	zassert_equal(co_od_hook_unregister(co_node_od(&t.node), &late_notified), 1);
+	co_node_unlock(&t.node);
+	co_sim_rx(0x200 + NODE_ID, 3, (const uint8_t[]){0x14, 0x25, 0x36});
+	zassert_equal(get_u16(0x2001, 0), 0x3625, "written without the removed hooks");
+	zassert_equal(late_notified, 1, "a removed hook no longer runs");
 }
 
 #if defined(CONFIG_CANOPEN_OD_PROVIDERS)
