@@ -18,7 +18,7 @@ FUZZ = os.path.join(BASE, "scripts", "fuzz")
 EDS_HARNESS_DIR = os.path.join(BASE, "tests", "fuzz", "eds2od")
 
 NAMES = ["nmt", "errctl", "sdo_server", "pdo", "sync", "time", "emcy", "sdo_client", "mgr",
-         "lss", "srdo", "cdcf", "eds2od"]
+         "lss", "srdo", "cdcf", "dcf", "eds2od"]
 
 needs_clang = pytest.mark.skipif(
     subprocess.run(["sh", "-c", "command -v clang"], capture_output=True).returncode != 0,
