@@ -70,10 +70,12 @@ def test_the_stack_gets_its_embedded_defaults(tmp_path, board):
     n, c = dotconfig(native), dotconfig(cross)
     assert c[f"CONFIG_BOARD_{board.upper()}"] == "y" and c["CONFIG_ARCH_POSIX"] == "y"
     assert "CONFIG_BOARD_NATIVE_POSIX" not in c
-    # two options whose default is the native board's own (subsys/canopen/*/Kconfig)
+    # a size whose default is the native board's own (subsys/canopen/*/Kconfig), and the lock
+    # check the native board's defconfig turns on (a check, not a feature: no bool default of
+    # the stack is keyed on the board)
     assert (n["CONFIG_CANOPEN_OD_SCRATCH_SIZE"], c["CONFIG_CANOPEN_OD_SCRATCH_SIZE"]) == ("256", "32")
-    assert n["CONFIG_CANOPEN_NODE_REDUNDANT_LINE"] == "y"
-    assert "CONFIG_CANOPEN_NODE_REDUNDANT_LINE" not in c
+    assert n["CONFIG_CANOPEN_LOCK_CHECK"] == "y"
+    assert "CONFIG_CANOPEN_LOCK_CHECK" not in c
     # and the kernel's own default tick rate, not the native board's
     assert (n["CONFIG_SYS_CLOCK_TICKS_PER_SEC"], c["CONFIG_SYS_CLOCK_TICKS_PER_SEC"]) == ("100000", "10000")
 
